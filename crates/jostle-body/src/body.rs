@@ -1,0 +1,254 @@
+//! `RigidBody`: one body's mass properties, state, forces and sleep state.
+
+use jostle_math::{Mat3, Quat, Vec3, world_inverse_inertia};
+use thiserror::Error;
+
+/// Why mass properties were rejected.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum MassError {
+    /// Mass must be finite and > 0.
+    #[error("mass must be finite and > 0, got {0}")]
+    Mass(f32),
+    /// Inertia must be a finite symmetric tensor with positive principal moments.
+    #[error("inertia must be finite with principal moments > 0, got {0:?}")]
+    Inertia(Vec3),
+}
+
+/// Sleep bookkeeping of a body (DESIGN.md, "Sleep and islands").
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct SleepState {
+    /// Whether the body is simulated this step.
+    pub awake: bool,
+    /// Whether the body may be put to sleep at all.
+    pub can_sleep: bool,
+    /// Recency-weighted average of |v|² + |ω|² (m²/s², rad²/s² treated alike).
+    pub motion: f32,
+}
+
+impl Default for SleepState {
+    fn default() -> Self {
+        Self { awake: true, can_sleep: true, motion: f32::MAX }
+    }
+}
+
+/// A rigid body: mass properties, pose, velocities, damping, accumulated force and torque,
+/// the acceleration of the last step, and sleep state.
+///
+/// A fixed body has zero inverse mass and inverse inertia, never moves, and is represented by
+/// the solver's single static entry. Poses are the centre of mass: `position` is where the
+/// centre of mass is, `orientation` rotates body space to world space.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct RigidBody {
+    /// Position of the centre of mass (m).
+    pub position: Vec3,
+    /// Orientation, body to world (unit quaternion).
+    pub orientation: Quat,
+    /// Linear velocity (m/s).
+    pub linear_velocity: Vec3,
+    /// Angular velocity (rad/s, world space).
+    pub angular_velocity: Vec3,
+    /// Linear damping (1/s): each step v ← v / (1 + dt·c). 0 = none (default).
+    pub linear_damping: f32,
+    /// Angular damping (1/s): each step ω ← ω / (1 + dt·c). 0 = none (default).
+    pub angular_damping: f32,
+    /// Linear acceleration of the last step (m/s²), see `SolverBody::last_acceleration`.
+    pub last_acceleration: Vec3,
+    /// Sleep state.
+    pub sleep: SleepState,
+    mass: f32,
+    inv_mass: f32,
+    inv_inertia_body: Mat3,
+    inv_inertia_world: Mat3,
+    force: Vec3,
+    torque: Vec3,
+    fixed: bool,
+}
+
+impl RigidBody {
+    /// A dynamic body of `mass` kg with body-space inertia tensor `inertia` (kg·m²), at the
+    /// origin, at rest. Errors on a non-finite or non-positive mass or inertia.
+    pub fn dynamic(mass: f32, inertia: Mat3) -> Result<Self, MassError> {
+        if !(mass.is_finite() && mass > 0.0) {
+            return Err(MassError::Mass(mass));
+        }
+        let diag = Vec3::new(inertia.x_axis.x, inertia.y_axis.y, inertia.z_axis.z);
+        let finite = inertia.to_cols_array().iter().all(|x| x.is_finite());
+        if !finite || diag.min_element() <= 0.0 || inertia.determinant() <= 0.0 {
+            return Err(MassError::Inertia(diag));
+        }
+        let mut body = Self::fixed();
+        body.fixed = false;
+        body.mass = mass;
+        body.inv_mass = 1.0 / mass;
+        body.inv_inertia_body = inertia.inverse();
+        body.update_world_inertia();
+        Ok(body)
+    }
+
+    /// An immovable body (infinite mass and inertia) at the origin.
+    pub fn fixed() -> Self {
+        Self {
+            position: Vec3::ZERO,
+            orientation: Quat::IDENTITY,
+            linear_velocity: Vec3::ZERO,
+            angular_velocity: Vec3::ZERO,
+            linear_damping: 0.0,
+            angular_damping: 0.0,
+            last_acceleration: Vec3::ZERO,
+            sleep: SleepState::default(),
+            mass: f32::INFINITY,
+            inv_mass: 0.0,
+            inv_inertia_body: Mat3::ZERO,
+            inv_inertia_world: Mat3::ZERO,
+            force: Vec3::ZERO,
+            torque: Vec3::ZERO,
+            fixed: true,
+        }
+    }
+
+    /// Sets the pose (builder style) and refreshes the world inverse inertia.
+    pub fn with_pose(mut self, position: Vec3, orientation: Quat) -> Self {
+        self.position = position;
+        self.orientation = orientation.normalize();
+        self.update_world_inertia();
+        self
+    }
+
+    /// Sets the velocities (builder style).
+    pub fn with_velocity(mut self, linear: Vec3, angular: Vec3) -> Self {
+        self.linear_velocity = linear;
+        self.angular_velocity = angular;
+        self
+    }
+
+    /// Whether the body is immovable.
+    pub fn is_fixed(&self) -> bool {
+        self.fixed
+    }
+
+    /// Whether the body is awake (fixed bodies report `false`: they are never simulated).
+    pub fn is_awake(&self) -> bool {
+        !self.fixed && self.sleep.awake
+    }
+
+    /// Mass (kg); infinite for a fixed body.
+    pub fn mass(&self) -> f32 {
+        self.mass
+    }
+
+    /// 1/mass (1/kg); zero for a fixed body.
+    pub fn inv_mass(&self) -> f32 {
+        self.inv_mass
+    }
+
+    /// Body-space inverse inertia tensor.
+    pub fn inv_inertia_body(&self) -> Mat3 {
+        self.inv_inertia_body
+    }
+
+    /// World-space inverse inertia R·I⁻¹·Rᵀ at the current orientation.
+    pub fn inv_inertia_world(&self) -> Mat3 {
+        self.inv_inertia_world
+    }
+
+    /// Recomputes the world inverse inertia from the orientation; call after changing
+    /// `orientation` directly.
+    pub fn update_world_inertia(&mut self) {
+        self.inv_inertia_world = world_inverse_inertia(self.orientation, self.inv_inertia_body);
+    }
+
+    /// Force accumulated for the next step (N).
+    pub fn force(&self) -> Vec3 {
+        self.force
+    }
+
+    /// Torque accumulated for the next step (N·m).
+    pub fn torque(&self) -> Vec3 {
+        self.torque
+    }
+
+    /// Adds a force through the centre of mass for the next step.
+    pub fn add_force(&mut self, force: Vec3) {
+        self.force += force;
+    }
+
+    /// Adds a torque for the next step.
+    pub fn add_torque(&mut self, torque: Vec3) {
+        self.torque += torque;
+    }
+
+    /// Adds a force applied at world point `point`: the force, plus the torque
+    /// (point − centre of mass) × force.
+    pub fn add_force_at_point(&mut self, force: Vec3, point: Vec3) {
+        self.force += force;
+        self.torque += (point - self.position).cross(force);
+    }
+
+    /// Applies an impulse (N·s) at world point `point` now: Δv = J/m, Δω = I⁻¹·(r × J).
+    /// No effect on a fixed body.
+    pub fn apply_impulse_at_point(&mut self, impulse: Vec3, point: Vec3) {
+        self.linear_velocity += impulse * self.inv_mass;
+        self.angular_velocity += self.inv_inertia_world * (point - self.position).cross(impulse);
+    }
+
+    /// Clears the force and torque accumulators (done after every step).
+    pub fn clear_forces(&mut self) {
+        self.force = Vec3::ZERO;
+        self.torque = Vec3::ZERO;
+    }
+
+    /// Kinetic energy ½·m·|v|² + ½·ω·I·ω (J); zero for a fixed body.
+    pub fn kinetic_energy(&self) -> f32 {
+        if self.fixed {
+            return 0.0;
+        }
+        let inertia_world = self.inv_inertia_world.inverse();
+        0.5 * self.mass * self.linear_velocity.length_squared()
+            + 0.5 * self.angular_velocity.dot(inertia_world * self.angular_velocity)
+    }
+
+    /// Whether every number in the body's state is finite.
+    pub fn is_finite(&self) -> bool {
+        self.position.is_finite()
+            && self.orientation.is_finite()
+            && self.linear_velocity.is_finite()
+            && self.angular_velocity.is_finite()
+            && self.force.is_finite()
+            && self.torque.is_finite()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn force_at_an_off_centre_point_produces_its_torque() {
+        let mut b = RigidBody::dynamic(2.0, Mat3::IDENTITY).unwrap();
+        b.position = Vec3::new(1.0, 0.0, 0.0);
+        // Push +Y at a point 1 m further along +X: torque r × F = (1,0,0) × (0,3,0) = (0,0,3).
+        b.add_force_at_point(Vec3::new(0.0, 3.0, 0.0), Vec3::new(2.0, 0.0, 0.0));
+        assert_eq!(b.force(), Vec3::new(0.0, 3.0, 0.0));
+        assert_eq!(b.torque(), Vec3::new(0.0, 0.0, 3.0));
+    }
+
+    #[test]
+    fn impulse_at_a_point_changes_both_velocities() {
+        let mut b = RigidBody::dynamic(10.0, Mat3::from_diagonal(Vec3::splat(240.0))).unwrap();
+        b.position = Vec3::new(20.1966, 16.1966, 0.0);
+        // The seed's cube-on-floor impulse: Δv = (0, 1.8734, 0), Δω = (0, 0, 0.1715).
+        b.apply_impulse_at_point(Vec3::new(0.0, 18.7337, 0.0), Vec3::new(22.3932, 8.0, 0.0));
+        assert!((b.linear_velocity.y - 1.87337).abs() < 1e-4);
+        assert!((b.angular_velocity.z - 0.1715).abs() < 1e-4);
+    }
+
+    #[test]
+    fn bad_mass_is_rejected() {
+        assert_eq!(RigidBody::dynamic(0.0, Mat3::IDENTITY), Err(MassError::Mass(0.0)));
+        assert!(RigidBody::dynamic(f32::NAN, Mat3::IDENTITY).is_err());
+        assert!(RigidBody::dynamic(1.0, Mat3::ZERO).is_err());
+        assert!(RigidBody::dynamic(1.0, Mat3::from_diagonal(Vec3::new(1.0, f32::INFINITY, 1.0))).is_err());
+    }
+}

@@ -1,0 +1,68 @@
+//! One contact point between two solver bodies, in DESIGN.md's convention.
+
+use jostle_math::Vec3;
+
+/// A contact point between body `a` and body `b` (indices into the solver-body slice; either
+/// may be [`crate::STATIC_BODY`]).
+///
+/// Convention (the seed's and Cyclone's): `normal` is unit and points from B toward A, the
+/// direction A must move to separate; `penetration` is positive when the bodies overlap and
+/// negative when they are apart by that distance (speculative contacts). `point` is the world
+/// position of the contact, midway between the two surfaces.
+///
+/// `impulse` is the impulse this contact applied to A during the last step, in contact space:
+/// x along the normal, y and z along the tangents of [`jostle_math::contact_basis`] of
+/// `normal` (N·s). The narrow phase carries it across steps by feature id; resolvers that warm
+/// start read it, and every resolver writes the impulse it applied, so the facade can report
+/// contact forces.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub struct Contact {
+    /// World-space contact point (m).
+    pub point: Vec3,
+    /// Penetration depth (m), positive when overlapping.
+    pub penetration: f32,
+    /// Unit contact normal, from B toward A.
+    pub normal: Vec3,
+    /// Combined friction coefficient μ (dimensionless). The collision layer mixes the two
+    /// materials as sqrt(μa·μb).
+    pub friction: f32,
+    /// Accumulated contact-space impulse on A (N·s): normal, tangent 1, tangent 2.
+    pub impulse: Vec3,
+    /// Combined restitution e in [0, 1]; mixed as max(ea, eb).
+    pub restitution: f32,
+    /// Index of body A in the solver-body slice.
+    pub a: u32,
+    /// Index of body B in the solver-body slice.
+    pub b: u32,
+}
+
+const _: () = assert!(size_of::<Contact>() <= 64);
+
+impl Contact {
+    /// A contact with no stored impulse.
+    pub fn new(a: u32, b: u32, point: Vec3, normal: Vec3, penetration: f32) -> Self {
+        Self {
+            point,
+            penetration,
+            normal,
+            friction: 0.0,
+            impulse: Vec3::ZERO,
+            restitution: 0.0,
+            a,
+            b,
+        }
+    }
+
+    /// Sets the combined friction coefficient.
+    pub fn with_friction(mut self, friction: f32) -> Self {
+        self.friction = friction;
+        self
+    }
+
+    /// Sets the combined restitution.
+    pub fn with_restitution(mut self, restitution: f32) -> Self {
+        self.restitution = restitution;
+        self
+    }
+}

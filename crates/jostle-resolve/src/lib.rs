@@ -1,0 +1,21 @@
+//! jostle-resolve turns solver bodies and contacts into velocity and pose corrections.
+//!
+//! In: a dense slice of [`SolverBody`] (index 0 is the shared static entry, never written), a
+//! slice of [`Contact`] referring to them by index, gravity and the time step. Out: the bodies'
+//! new poses and velocities after one step, and the contacts' accumulated impulses (for warm
+//! starting the next step). It knows nothing of shapes, parry or body storage, and depends on
+//! `jostle-math` alone, so a resolver can be benchmarked on synthetic contacts and swapped
+//! without the rest of the engine.
+//!
+//! Resolvers implement [`Resolver`]; the facade calls the same trait method whatever the
+//! resolver, with no special case.
+#![deny(missing_docs)]
+
+pub mod contact;
+pub mod integrate;
+pub mod resolver;
+pub mod solver_body;
+
+pub use contact::Contact;
+pub use resolver::{ResolveStats, Resolver, StepContext};
+pub use solver_body::{STATIC_BODY, SolverBody};

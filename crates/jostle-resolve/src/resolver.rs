@@ -1,0 +1,67 @@
+//! The `Resolver` trait: the one contract every contact resolver meets.
+
+use crate::{Contact, SolverBody};
+use jostle_math::Vec3;
+use std::time::Duration;
+
+/// What a resolver needs to know about the step besides bodies and contacts.
+/// Built fresh for every step, never stored.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepContext {
+    /// Gravity (m/s²), applied to every body with non-zero inverse mass.
+    pub gravity: Vec3,
+    /// Step length (s), finite and > 0.
+    pub dt: f32,
+}
+
+/// What one resolver step did, for the step profile. Resolvers fill what applies to them.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ResolveStats {
+    /// Time spent integrating velocities and poses.
+    pub integrate_time: Duration,
+    /// Time spent preparing contacts (bases, lever arms, desired velocity changes).
+    pub prepare_time: Duration,
+    /// Time spent resolving interpenetration (position pass or soft-constraint bias).
+    pub position_time: Duration,
+    /// Time spent resolving velocities (impulses).
+    pub velocity_time: Duration,
+    /// Position iterations (picks) performed.
+    pub position_iterations: u32,
+    /// Velocity iterations (picks) performed.
+    pub velocity_iterations: u32,
+    /// Independent contact islands solved.
+    pub islands: u32,
+}
+
+/// A contact resolver: advances the awake bodies by one step of `dt`, resolving the given
+/// contacts.
+///
+/// # Contract
+/// - `bodies[STATIC_BODY]` is [`SolverBody::STATIC`] and must not be written. Every other
+///   entry is an awake dynamic body; the resolver **owns its integration**: it applies gravity
+///   to velocities, integrates velocities into poses (semi-implicit Euler, orientation by
+///   [`jostle_math::integrate_orientation`]) and records `last_acceleration`. Forces have
+///   already been applied to velocities by the caller.
+/// - `contacts` were detected on the poses the bodies have on entry. The resolver may reorder
+///   nothing and must write each contact's `impulse` (contact space, on A); it may update
+///   `penetration` to the value it believes remains.
+/// - Units are SI; the normal points from B toward A; penetration is positive on overlap.
+/// - No panics on finite input. Non-finite input may produce non-finite output, which the
+///   caller detects and quarantines.
+/// - Deterministic: the same inputs give bit-identical outputs.
+///
+/// The Millington resolver resolves contacts and then integrates (Cyclone's frame order,
+/// shifted so detection comes first); the soft-step resolver integrates inside its substeps.
+/// Both fit this one method.
+pub trait Resolver: Send {
+    /// Short stable name (`"millington"`, `"soft-step"`), as used on the command line.
+    fn name(&self) -> &'static str;
+
+    /// Advances `bodies` by one step, resolving `contacts`. See the trait's contract.
+    fn step(
+        &mut self,
+        bodies: &mut [SolverBody],
+        contacts: &mut [Contact],
+        ctx: &StepContext,
+    ) -> ResolveStats;
+}

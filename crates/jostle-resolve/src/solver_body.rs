@@ -1,0 +1,96 @@
+//! The solver's hot, dense view of a rigid body.
+
+use jostle_math::{Mat3, Quat, Vec3};
+
+/// Index of the shared static entry in every solver-body slice: an immovable body at the
+/// origin with zero velocity, zero inverse mass and zero inverse inertia. Contacts against
+/// any fixed body (ground, walls, meshes) name this index. Resolvers never write it, which is
+/// what lets independent islands be solved in parallel.
+pub const STATIC_BODY: u32 = 0;
+
+/// What a resolver reads and writes of one body, and nothing more: pose, velocities, inverse
+/// mass, world-space inverse inertia, the acceleration of the last integration, and flags.
+///
+/// Fields are ordered hot to cold and sized to two cache lines. The facade copies the awake
+/// bodies of the world into a `Vec<SolverBody>` at the start of the step (index 0 is
+/// [`SolverBody::STATIC`]) and copies poses and velocities back at the end; the user's
+/// `RigidBody` is never touched by a resolver.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub struct SolverBody {
+    /// Orientation (unit quaternion, x y z w).
+    pub orientation: Quat,
+    /// Position of the centre of mass in world space (m).
+    pub position: Vec3,
+    /// 1/mass (1/kg); zero for an immovable body.
+    pub inv_mass: f32,
+    /// Linear velocity of the centre of mass (m/s).
+    pub linear_velocity: Vec3,
+    /// Flags, see [`SolverBody::ROTATES`].
+    pub flags: u32,
+    /// Angular velocity (rad/s), world space.
+    pub angular_velocity: Vec3,
+    /// World-space inverse inertia tensor R·I⁻¹·Rᵀ (1/(kg·m²)); zero for a body that cannot
+    /// rotate. Resolvers that rotate a body within the step keep it as given (first order), and
+    /// the facade recomputes it from the new orientation at the next step.
+    pub inv_inertia: Mat3,
+    /// Linear acceleration applied by the last integration (m/s²): the velocity it added
+    /// was `last_acceleration * dt`. The Millington resolver's micro-collision rule removes it
+    /// from closing velocities. jostle records gravity here (forces are applied as impulses
+    /// before the resolver runs; the lecture allows "ignoring any force except gravity").
+    pub last_acceleration: Vec3,
+}
+
+const _: () = assert!(size_of::<SolverBody>() <= 112);
+
+impl SolverBody {
+    /// Flag: the body's inverse inertia is non-zero, so resolvers do angular work for it.
+    /// Clear it to skip every angular term of a body that cannot rotate.
+    pub const ROTATES: u32 = 1;
+
+    /// The shared static entry: immovable, at rest, never written.
+    pub const STATIC: SolverBody = SolverBody {
+        orientation: Quat::IDENTITY,
+        position: Vec3::ZERO,
+        inv_mass: 0.0,
+        linear_velocity: Vec3::ZERO,
+        flags: 0,
+        angular_velocity: Vec3::ZERO,
+        inv_inertia: Mat3::ZERO,
+        last_acceleration: Vec3::ZERO,
+    };
+
+    /// A dynamic body at `position` with the given inverse mass and world inverse inertia,
+    /// at rest, with [`SolverBody::ROTATES`] set when the inverse inertia is non-zero.
+    pub fn new(position: Vec3, orientation: Quat, inv_mass: f32, inv_inertia: Mat3) -> Self {
+        let rotates = inv_inertia != Mat3::ZERO;
+        Self {
+            orientation,
+            position,
+            inv_mass,
+            linear_velocity: Vec3::ZERO,
+            flags: if rotates { Self::ROTATES } else { 0 },
+            angular_velocity: Vec3::ZERO,
+            inv_inertia,
+            last_acceleration: Vec3::ZERO,
+        }
+    }
+
+    /// Whether angular terms apply to this body.
+    #[inline]
+    pub fn rotates(&self) -> bool {
+        self.flags & Self::ROTATES != 0
+    }
+
+    /// Whether the body can move at all (non-zero inverse mass or inverse inertia).
+    #[inline]
+    pub fn is_movable(&self) -> bool {
+        self.inv_mass > 0.0 || self.rotates()
+    }
+
+    /// Velocity of the body's material point at world position `point` (m/s): v + ω × r.
+    #[inline]
+    pub fn velocity_at(&self, point: Vec3) -> Vec3 {
+        self.linear_velocity + self.angular_velocity.cross(point - self.position)
+    }
+}
