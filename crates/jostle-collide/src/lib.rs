@@ -1,1 +1,36 @@
-//! placeholder
+//! jostle-collide finds where bodies touch: colliders (parry shapes with a material, attached
+//! to bodies), the broad phase, the persistent narrow phase and scene queries.
+//!
+//! In: a [`ColliderSet`] and the `BodySet` whose poses (centre of mass, orientation) and sleep
+//! states it reads. Out: candidate [`ColliderPair`]s, [`BodyContact`]s in jostle's convention
+//! (normal from body B toward body A, penetration positive on overlap, at most four points per
+//! manifold, warm-start impulses carried by feature id), touching [`CollisionEvent`]s, ray and
+//! overlap queries, and mass properties of shape descriptions.
+//! It is the only jostle crate that names parry types (re-exported as [`parry3d`]); it depends
+//! on `jostle-math` and `jostle-body` and knows nothing of the resolver or of sleep islands.
+//!
+//! Per step: [`BroadPhase::update`] → [`NarrowPhase::update`] → (resolver) →
+//! [`NarrowPhase::store_impulses`].
+#![deny(missing_docs)]
+
+pub mod broad_phase;
+pub mod collider;
+pub mod mass;
+pub mod material;
+pub mod narrow_phase;
+pub mod query;
+pub mod reduce;
+pub mod settings;
+pub mod shape;
+
+pub use broad_phase::{BroadPhase, ColliderPair};
+pub use collider::{Collider, ColliderHandle, ColliderSet, body_pose};
+pub use mass::{MassProps, mass_properties};
+pub use material::Material;
+pub use narrow_phase::{BodyContact, CollisionEvent, NarrowPhase, NarrowStats};
+pub use parry3d;
+pub use parry3d::math::Pose;
+pub use parry3d::shape::SharedShape;
+pub use query::{RayHit, intersect_shape, ray_cast};
+pub use settings::CollideSettings;
+pub use shape::{CompoundPart, ShapeDesc, ShapeError};

@@ -1,0 +1,393 @@
+//! Broad phase: candidate collider pairs from bounding boxes, with parry's [`Bvh`].
+//!
+//! In: the colliders and the bodies' poses and sleep states. Out: the sorted list of
+//! [`ColliderPair`]s whose bounding boxes, each enlarged by a margin, overlap.
+//!
+//! Invariants of the output: at least one of the two bodies is awake (never static–static,
+//! sleeping–sleeping or sleeping–static), never two colliders of the same body, each pair once
+//! with the lower handle first, sorted by handle pair — so the result is deterministic and is
+//! exactly the set a brute-force all-pairs test of the enlarged boxes gives.
+//!
+//! How: every bounded collider is a leaf of one BVH holding a *fat* box (the enlarged box grown
+//! by a further `slack`), rewritten only when the enlarged box escapes it, so slowly moving
+//! bodies leave the tree untouched; the tree is refitted and incrementally optimized when a
+//! leaf changed. Each awake collider then queries the tree with its exact enlarged box and the
+//! hits are filtered by the exact boxes: O(n log n) for n awake colliders, and sleeping or
+//! fixed colliders are visited only to check that their pose did not change.
+//! Unbounded shapes (half-spaces) never enter the tree: each is tested directly against every
+//! awake collider's box (or against every box if it is itself awake).
+
+use crate::collider::{Collider, ColliderHandle, ColliderSet};
+use jostle_body::{BodyHandle, BodySet};
+use jostle_math::Vec3;
+use parry3d::bounding_volume::{Aabb, BoundingVolume};
+use parry3d::math::Pose;
+use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhWorkspace};
+
+/// Two colliders whose enlarged bounding boxes overlap; the lower handle first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ColliderPair(pub ColliderHandle, pub ColliderHandle);
+
+impl ColliderPair {
+    /// The pair with the lower handle first.
+    pub fn new(a: ColliderHandle, b: ColliderHandle) -> Self {
+        if a <= b { Self(a, b) } else { Self(b, a) }
+    }
+}
+
+/// What the broad phase remembers of one collider slot.
+#[derive(Clone, Debug)]
+struct Proxy {
+    generation: u32,
+    body: BodyHandle,
+    awake: bool,
+    unbounded: bool,
+    /// World outward normal of an unbounded (half-space) collider; zero otherwise.
+    normal: Vec3,
+    /// World pose and shape identity the boxes were computed for.
+    pose: Pose,
+    shape_id: usize,
+    /// The shape's box at `pose`, enlarged by the margin: what pairs are decided on.
+    aabb: Aabb,
+    /// The box stored in the tree: contains `aabb`, grown by `slack` when last rewritten.
+    fat: Option<Aabb>,
+}
+
+/// The broad phase. Keep one per world and call [`BroadPhase::update`] once per step.
+#[derive(Clone)]
+pub struct BroadPhase {
+    tree: Bvh,
+    workspace: BvhWorkspace,
+    proxies: Vec<Option<Proxy>>,
+    margin: f32,
+    slack: f32,
+    pairs: Vec<ColliderPair>,
+    awake_bounded: Vec<u32>,
+    unbounded: Vec<u32>,
+    new_leaves: Vec<u32>,
+}
+
+impl std::fmt::Debug for BroadPhase {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("BroadPhase")
+            .field("leaves", &self.tree.leaf_count())
+            .field("margin", &self.margin)
+            .field("slack", &self.slack)
+            .field("pairs", &self.pairs.len())
+            .finish()
+    }
+}
+
+impl Default for BroadPhase {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Default fattening of the boxes stored in the tree (m): a body may move this far before its
+/// leaf is rewritten. Larger means fewer tree updates but more candidates to filter.
+pub const DEFAULT_SLACK: f32 = 0.05;
+
+/// Above this many new leaves (and half the tree), the tree is rebuilt rather than grown.
+const REBUILD_MIN_NEW_LEAVES: usize = 64;
+
+impl BroadPhase {
+    /// An empty broad phase with the default slack ([`DEFAULT_SLACK`]).
+    pub fn new() -> Self {
+        Self::with_slack(DEFAULT_SLACK)
+    }
+
+    /// An empty broad phase whose tree boxes are fattened by `slack` metres (≥ 0; a bad value
+    /// falls back to the default). Slack changes cost, never the pairs reported.
+    pub fn with_slack(slack: f32) -> Self {
+        let slack = if slack.is_finite() && slack >= 0.0 {
+            slack
+        } else {
+            DEFAULT_SLACK
+        };
+        Self {
+            tree: Bvh::new(),
+            workspace: BvhWorkspace::default(),
+            proxies: Vec::new(),
+            margin: f32::NAN,
+            slack,
+            pairs: Vec::new(),
+            awake_bounded: Vec::new(),
+            unbounded: Vec::new(),
+            new_leaves: Vec::new(),
+        }
+    }
+
+    /// The pairs of the last update.
+    pub fn pairs(&self) -> &[ColliderPair] {
+        &self.pairs
+    }
+
+    /// The enlarged box of `collider` as of the last update (`None` for an unknown or
+    /// unbounded collider).
+    pub fn aabb(&self, collider: ColliderHandle) -> Option<Aabb> {
+        let p = self.proxies.get(collider.index() as usize)?.as_ref()?;
+        (p.generation == collider.generation() && !p.unbounded).then_some(p.aabb)
+    }
+
+    /// Recomputes the candidate pairs: every pair of colliders whose bounding boxes, each
+    /// enlarged by `margin` metres on every side, overlap, and that passes the filters of the
+    /// module docs. Pass at least half the narrow phase's prediction distance as `margin`.
+    ///
+    /// Colliders whose body handle is stale are ignored (and forgotten).
+    pub fn update(
+        &mut self,
+        colliders: &ColliderSet,
+        bodies: &BodySet,
+        margin: f32,
+    ) -> &[ColliderPair] {
+        let margin = if margin.is_finite() {
+            margin.max(0.0)
+        } else {
+            0.0
+        };
+        let margin_changed = margin != self.margin;
+        self.margin = margin;
+        let tree_changed = self.update_proxies(colliders, bodies, margin_changed);
+        if tree_changed {
+            self.tree.refit(&mut self.workspace);
+            self.tree.optimize_incremental(&mut self.workspace);
+        }
+        self.find_pairs();
+        &self.pairs
+    }
+
+    /// Brings every proxy up to date with its collider; returns whether the tree changed.
+    fn update_proxies(&mut self, colliders: &ColliderSet, bodies: &BodySet, force: bool) -> bool {
+        let n = colliders.capacity_index();
+        let mut tree_changed = false;
+        if self.proxies.len() > n {
+            for i in n..self.proxies.len() {
+                tree_changed |= self.forget(i as u32);
+            }
+            self.proxies.truncate(n);
+        }
+        self.proxies.resize(n, None);
+        self.awake_bounded.clear();
+        self.unbounded.clear();
+        self.new_leaves.clear();
+
+        for i in 0..n as u32 {
+            let live = colliders
+                .by_index(i)
+                .and_then(|(h, c)| bodies.get(c.body).map(|b| (h, c, b)));
+            let Some((handle, collider, body)) = live else {
+                tree_changed |= self.forget(i);
+                continue;
+            };
+            let pose = collider.world_pose(body);
+            let shape_id = shape_id(collider);
+            let awake = body.is_awake();
+            let proxy = &mut self.proxies[i as usize];
+            let fresh = match proxy {
+                Some(p) => {
+                    force
+                        || p.generation != handle.generation()
+                        || p.pose != pose
+                        || p.shape_id != shape_id
+                }
+                None => true,
+            };
+            if fresh {
+                let unbounded = collider.is_unbounded();
+                let aabb = if unbounded {
+                    Aabb::new_invalid()
+                } else {
+                    collider.shape.compute_aabb(&pose).loosened(self.margin)
+                };
+                let normal = collider
+                    .shape
+                    .as_halfspace()
+                    .map_or(Vec3::ZERO, |h| pose.rotation * h.normal);
+                let fat = proxy.as_ref().and_then(|p| p.fat);
+                *proxy = Some(Proxy {
+                    generation: handle.generation(),
+                    body: collider.body,
+                    awake,
+                    unbounded,
+                    normal,
+                    pose,
+                    shape_id,
+                    aabb,
+                    fat,
+                });
+                tree_changed |= self.refresh_leaf(i);
+            }
+            let Some(p) = &mut self.proxies[i as usize] else {
+                continue;
+            };
+            p.awake = awake;
+            p.body = collider.body;
+            if p.unbounded {
+                self.unbounded.push(i);
+            } else if awake {
+                self.awake_bounded.push(i);
+            }
+        }
+
+        if !self.new_leaves.is_empty() {
+            tree_changed = true;
+            let total = self.tree.leaf_count() as usize + self.new_leaves.len();
+            if self.new_leaves.len() >= REBUILD_MIN_NEW_LEAVES && 2 * self.new_leaves.len() >= total
+            {
+                self.rebuild_tree();
+            } else {
+                for k in 0..self.new_leaves.len() {
+                    let i = self.new_leaves[k];
+                    if let Some(fat) = self.proxies[i as usize].as_ref().and_then(|p| p.fat) {
+                        self.tree.insert_or_update_partially(fat, i, 0.0);
+                    }
+                }
+            }
+        }
+        tree_changed
+    }
+
+    /// Rewrites slot `i`'s leaf if its enlarged box left the fat box (or it has none yet);
+    /// new leaves are queued in `new_leaves`. Returns whether an existing leaf changed.
+    fn refresh_leaf(&mut self, i: u32) -> bool {
+        let Some(p) = self.proxies[i as usize].as_mut() else {
+            return false;
+        };
+        if p.unbounded {
+            return p.fat.take().is_some() && {
+                self.tree.remove(i);
+                true
+            };
+        }
+        match p.fat {
+            Some(fat) if fat.contains(&p.aabb) => false,
+            Some(_) => {
+                let fat = p.aabb.loosened(self.slack);
+                p.fat = Some(fat);
+                self.tree.insert_or_update_partially(fat, i, 0.0);
+                true
+            }
+            None => {
+                p.fat = Some(p.aabb.loosened(self.slack));
+                self.new_leaves.push(i);
+                false
+            }
+        }
+    }
+
+    /// Drops slot `i`'s proxy and leaf; returns whether the tree changed.
+    fn forget(&mut self, i: u32) -> bool {
+        match self.proxies.get_mut(i as usize).and_then(Option::take) {
+            Some(Proxy { fat: Some(_), .. }) => {
+                self.tree.remove(i);
+                true
+            }
+            _ => false,
+        }
+    }
+
+    fn rebuild_tree(&mut self) {
+        let leaves = self
+            .proxies
+            .iter()
+            .enumerate()
+            .filter_map(|(i, p)| p.as_ref().and_then(|p| p.fat).map(|fat| (i, fat)));
+        self.tree = Bvh::from_iter(BvhBuildStrategy::Binned, leaves);
+    }
+
+    fn handle(&self, i: u32) -> ColliderHandle {
+        let generation = self.proxies[i as usize]
+            .as_ref()
+            .map_or(0, |p| p.generation);
+        ColliderHandle::new(i, generation)
+    }
+
+    fn find_pairs(&mut self) {
+        self.pairs.clear();
+        for &i in &self.awake_bounded {
+            let Some(pi) = &self.proxies[i as usize] else {
+                continue;
+            };
+            for j in self.tree.intersect_aabb(&pi.aabb) {
+                if j == i {
+                    continue;
+                }
+                let Some(pj) = &self.proxies[j as usize] else {
+                    continue;
+                };
+                // Awake–awake pairs are found from both sides: keep the one from the lower slot.
+                if (pj.awake && j < i) || pj.body == pi.body || !pi.aabb.intersects(&pj.aabb) {
+                    continue;
+                }
+                self.pairs.push(ColliderPair::new(
+                    ColliderHandle::new(i, pi.generation),
+                    ColliderHandle::new(j, pj.generation),
+                ));
+            }
+        }
+        self.find_unbounded_pairs();
+        self.pairs.sort_unstable();
+        self.pairs.dedup();
+    }
+
+    fn find_unbounded_pairs(&mut self) {
+        for (k, &u) in self.unbounded.iter().enumerate() {
+            let Some(pu) = &self.proxies[u as usize] else {
+                continue;
+            };
+            let hu = self.handle(u);
+            let test = |_j: u32, pj: &Proxy| {
+                pj.body != pu.body && !pj.unbounded && halfspace_overlaps(pu, &pj.aabb, self.margin)
+            };
+            if pu.awake {
+                for (j, pj) in self.proxies.iter().enumerate() {
+                    if let Some(pj) = pj.as_ref().filter(|pj| test(j as u32, pj)) {
+                        self.pairs.push(ColliderPair::new(
+                            hu,
+                            ColliderHandle::new(j as u32, pj.generation),
+                        ));
+                    }
+                }
+            } else {
+                for &j in &self.awake_bounded {
+                    if let Some(pj) = self.proxies[j as usize].as_ref().filter(|pj| test(j, pj)) {
+                        self.pairs
+                            .push(ColliderPair::new(hu, ColliderHandle::new(j, pj.generation)));
+                    }
+                }
+            }
+            // Two unbounded shapes: a candidate whenever one of them is awake.
+            for &v in &self.unbounded[k + 1..] {
+                if let Some(pv) = &self.proxies[v as usize]
+                    && (pu.awake || pv.awake)
+                    && pu.body != pv.body
+                {
+                    self.pairs
+                        .push(ColliderPair::new(hu, ColliderHandle::new(v, pv.generation)));
+                }
+            }
+        }
+    }
+}
+
+/// Identity of a collider's shape (the address of its shared allocation), so that replacing
+/// the shape of a resting collider is noticed.
+fn shape_id(collider: &Collider) -> usize {
+    std::sync::Arc::as_ptr(&collider.shape.0) as *const () as usize
+}
+
+/// Whether `aabb` (already enlarged by the margin) reaches the half-space of `plane`, itself
+/// enlarged by `margin`: the box's lowest point along the outward normal is within `margin`
+/// of the plane or below it.
+fn halfspace_overlaps(plane: &Proxy, aabb: &Aabb, margin: f32) -> bool {
+    aabb_halfspace_distance(&plane.pose, plane.normal, aabb) <= margin
+}
+
+/// Signed distance from a half-space (plane through `pose.translation`, world outward normal
+/// `n`) to the lowest point of `aabb` along `n`: ≤ 0 when the box touches the half-space.
+pub fn aabb_halfspace_distance(pose: &Pose, n: Vec3, aabb: &Aabb) -> f32 {
+    let c = aabb.center();
+    let h = aabb.half_extents();
+    n.dot(c - pose.translation) - n.abs().dot(h)
+}

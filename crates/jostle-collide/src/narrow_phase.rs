@@ -1,0 +1,485 @@
+//! Narrow phase: persistent contact manifolds for the broad phase's candidate pairs.
+//!
+//! In: the sorted candidate pairs, the colliders, the bodies' poses and the settings. Out:
+//! [`BodyContact`]s in jostle's convention (normal from body B toward body A, penetration
+//! positive on overlap), [`CollisionEvent`]s and [`NarrowStats`].
+//!
+//! Each pair keeps its parry manifolds and workspace from step to step, so parry's coherence
+//! (and its feature ids) carries over; each manifold is reduced to at most four points
+//! ([`crate::reduce`]); each point carries the resolver's accumulated impulse, matched by
+//! (sub-shapes, feature ids) when the manifold is recomputed. A pair whose relative pose moved
+//! less than the reuse tolerances since its manifold was computed is not recomputed: only its
+//! separations are refreshed, and its world points are rebuilt from the local points, so they
+//! follow the bodies. Pairs that left the candidate list are dropped.
+
+use crate::broad_phase::ColliderPair;
+use crate::collider::{Collider, ColliderSet};
+use crate::material::Material;
+use crate::reduce::reduce_manifold;
+use crate::settings::CollideSettings;
+use jostle_body::{BodyHandle, BodySet};
+use jostle_math::Vec3;
+use parry3d::math::Pose;
+use parry3d::query::{
+    ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
+};
+use parry3d::shape::PackedFeatureId;
+use std::borrow::Cow;
+
+/// One contact point between two bodies, ready for the resolver.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyContact {
+    /// Body A: the normal points toward it. The dynamic body when the other is fixed.
+    pub a: BodyHandle,
+    /// Body B.
+    pub b: BodyHandle,
+    /// World contact point, midway between the two surfaces (m).
+    pub point: Vec3,
+    /// Unit world normal from B toward A: the direction A must move to separate.
+    pub normal: Vec3,
+    /// Penetration depth along the normal (m): positive on overlap, negative (the separation)
+    /// for a speculative contact within the prediction distance.
+    pub penetration: f32,
+    /// Mixed friction coefficient ([`Material::mix`]).
+    pub friction: f32,
+    /// Mixed restitution ([`Material::mix`]).
+    pub restitution: f32,
+    /// The resolver's accumulated impulse of the last step for this point, in contact space
+    /// (x along the normal), for warm starting; zero for a new point.
+    pub impulse: Vec3,
+}
+
+/// Two bodies started or stopped touching (some contact point with penetration ≥ 0) during an
+/// update. The lower body handle comes first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum CollisionEvent {
+    /// The bodies touch now and did not at the previous update.
+    Started(BodyHandle, BodyHandle),
+    /// The bodies touched at the previous update and no longer do (or one was removed).
+    Stopped(BodyHandle, BodyHandle),
+}
+
+/// Counts of one narrow-phase update.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NarrowStats {
+    /// Candidate pairs received from the broad phase.
+    pub candidate_pairs: usize,
+    /// Manifolds with at least one point.
+    pub manifolds: usize,
+    /// Contact points produced (the length of [`NarrowPhase::contacts`]).
+    pub contact_points: usize,
+    /// Manifolds (with at least one point) reused without recomputation because their pair's
+    /// relative pose moved less than the reuse tolerances.
+    pub manifolds_reused: usize,
+}
+
+/// Per-point data kept in parry's manifolds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct PointData {
+    impulse: Vec3,
+}
+
+type Manifold = ContactManifold<(), PointData>;
+
+/// What a pair's manifolds were last computed for.
+#[derive(Clone, Debug)]
+struct Computed {
+    pos12: Pose,
+    prediction: f32,
+    shapes: (usize, usize),
+}
+
+#[derive(Clone)]
+struct PairState {
+    pair: ColliderPair,
+    manifolds: Vec<Manifold>,
+    workspace: Option<ContactManifoldsWorkspace>,
+    computed: Option<Computed>,
+}
+
+impl PairState {
+    fn new(pair: ColliderPair) -> Self {
+        Self {
+            pair,
+            manifolds: Vec::new(),
+            workspace: None,
+            computed: None,
+        }
+    }
+}
+
+/// Where a contact of `contacts()` lives: pair, manifold and point indices.
+#[derive(Clone, Copy, Debug)]
+struct PointSlot {
+    pair: u32,
+    manifold: u32,
+    point: u32,
+}
+
+/// The narrow phase. Keep one per world and call [`NarrowPhase::update`] once per step.
+#[derive(Clone, Default)]
+pub struct NarrowPhase {
+    pairs: Vec<PairState>,
+    contacts: Vec<BodyContact>,
+    slots: Vec<PointSlot>,
+    touching: Vec<(BodyHandle, BodyHandle)>,
+    events: Vec<CollisionEvent>,
+}
+
+impl std::fmt::Debug for NarrowPhase {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("NarrowPhase")
+            .field("pairs", &self.pairs.len())
+            .field("contacts", &self.contacts.len())
+            .field("touching", &self.touching.len())
+            .finish()
+    }
+}
+
+impl NarrowPhase {
+    /// An empty narrow phase.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The contacts of the last update: pairs in pair order, points in manifold order.
+    pub fn contacts(&self) -> &[BodyContact] {
+        &self.contacts
+    }
+
+    /// The touching events of the last update, sorted.
+    pub fn events(&self) -> &[CollisionEvent] {
+        &self.events
+    }
+
+    /// Number of pairs with persistent state.
+    pub fn pair_count(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// Forgets every pair (the next update starts cold: no warm start, no events carried).
+    pub fn clear(&mut self) {
+        *self = Self::default();
+    }
+
+    /// Writes the resolver's accumulated impulses back into the persistent points, one per
+    /// contact of [`NarrowPhase::contacts`], in the same order. Extra impulses are ignored;
+    /// contacts without one keep theirs.
+    pub fn store_impulses(&mut self, impulses: &[Vec3]) {
+        for ((slot, contact), &impulse) in self.slots.iter().zip(&mut self.contacts).zip(impulses) {
+            contact.impulse = impulse;
+            let point = self
+                .pairs
+                .get_mut(slot.pair as usize)
+                .and_then(|p| p.manifolds.get_mut(slot.manifold as usize))
+                .and_then(|m| m.points.get_mut(slot.point as usize));
+            if let Some(point) = point {
+                point.data.impulse = impulse;
+            }
+        }
+    }
+
+    /// Updates the manifolds of `pairs` (as the broad phase gives them: sorted, unique; other
+    /// input is sorted first) and rebuilds the contacts and events.
+    pub fn update(
+        &mut self,
+        pairs: &[ColliderPair],
+        colliders: &ColliderSet,
+        bodies: &BodySet,
+        settings: &CollideSettings,
+    ) -> NarrowStats {
+        let pairs: Cow<[ColliderPair]> = if pairs.windows(2).all(|w| w[0] < w[1]) {
+            Cow::Borrowed(pairs)
+        } else {
+            let mut sorted = pairs.to_vec();
+            sorted.sort_unstable();
+            sorted.dedup();
+            Cow::Owned(sorted)
+        };
+        let mut stats = NarrowStats {
+            candidate_pairs: pairs.len(),
+            ..NarrowStats::default()
+        };
+        self.contacts.clear();
+        self.slots.clear();
+        let mut touching = Vec::new();
+
+        let old = std::mem::take(&mut self.pairs);
+        let mut old = old.into_iter().peekable();
+        for &pair in pairs.iter() {
+            while old.next_if(|s| s.pair < pair).is_some() {}
+            let mut state = old
+                .next_if(|s| s.pair == pair)
+                .unwrap_or_else(|| PairState::new(pair));
+            let (Some(c1), Some(c2)) = (colliders.get(pair.0), colliders.get(pair.1)) else {
+                continue;
+            };
+            let (Some(b1), Some(b2)) = (bodies.get(c1.body), bodies.get(c2.body)) else {
+                continue;
+            };
+            let pose1 = c1.world_pose(b1);
+            let pose2 = c2.world_pose(b2);
+            if !(pose1.is_finite() && pose2.is_finite()) {
+                // Non-finite state is the facade's to report; it must not reach parry.
+                continue;
+            }
+            let pos12 = pose1.inv_mul(&pose2);
+            if reusable(&state, &pos12, (shape_id(c1), shape_id(c2)), settings) {
+                for m in &mut state.manifolds {
+                    m.update_separations(&manifold_pos12(m, &pos12));
+                }
+                stats.manifolds_reused += state
+                    .manifolds
+                    .iter()
+                    .filter(|m| !m.points.is_empty())
+                    .count();
+            } else {
+                compute(&mut state, c1, c2, &pos12, settings.prediction);
+            }
+
+            // A is the dynamic body when the other is fixed; else collider 1's body.
+            let flip = b1.is_fixed() && !b2.is_fixed();
+            let (a, b) = if flip {
+                (c2.body, c1.body)
+            } else {
+                (c1.body, c2.body)
+            };
+            let material = Material::mix(c1.material, c2.material);
+            let pair_index = self.pairs.len() as u32;
+            let mut touches = false;
+            for (mi, m) in state.manifolds.iter().enumerate() {
+                let w1 = pose1 * m.subshape_pos1().copied().unwrap_or(Pose::IDENTITY);
+                let w2 = pose2 * m.subshape_pos2().copied().unwrap_or(Pose::IDENTITY);
+                // parry's normal points out of shape 1, toward shape 2.
+                let Some(n1) = (w1.rotation * m.local_n1).try_normalize() else {
+                    continue;
+                };
+                if m.points.is_empty() {
+                    continue;
+                }
+                stats.manifolds += 1;
+                let normal = if flip { n1 } else { -n1 };
+                for (pi, pt) in m.points.iter().enumerate() {
+                    let p1 = w1 * pt.local_p1;
+                    let p2 = w2 * pt.local_p2;
+                    touches |= pt.dist <= 0.0;
+                    self.contacts.push(BodyContact {
+                        a,
+                        b,
+                        point: (p1 + p2) * 0.5,
+                        normal,
+                        penetration: -pt.dist,
+                        friction: material.friction,
+                        restitution: material.restitution,
+                        impulse: pt.data.impulse,
+                    });
+                    self.slots.push(PointSlot {
+                        pair: pair_index,
+                        manifold: mi as u32,
+                        point: pi as u32,
+                    });
+                }
+            }
+            if touches {
+                touching.push(ordered(c1.body, c2.body));
+            }
+            self.pairs.push(state);
+        }
+        stats.contact_points = self.contacts.len();
+        self.update_events(touching, bodies);
+        stats
+    }
+
+    /// Diffs the touching body pairs against the previous update's. A pair that left the
+    /// candidate list because neither body is awake any more (it fell asleep on the other, or
+    /// on a fixed body) still counts as touching: sleeping does not stop a contact.
+    fn update_events(&mut self, mut touching: Vec<(BodyHandle, BodyHandle)>, bodies: &BodySet) {
+        let frozen = |&(a, b): &(BodyHandle, BodyHandle)| match (bodies.get(a), bodies.get(b)) {
+            (Some(a), Some(b)) => !a.is_awake() && !b.is_awake(),
+            _ => false,
+        };
+        touching.extend(self.touching.iter().copied().filter(frozen));
+        touching.sort_unstable();
+        touching.dedup();
+
+        self.events.clear();
+        let (old, new) = (&self.touching, &touching);
+        let (mut i, mut j) = (0, 0);
+        while i < old.len() || j < new.len() {
+            match (old.get(i), new.get(j)) {
+                (Some(o), Some(n)) if o == n => {
+                    i += 1;
+                    j += 1;
+                }
+                (Some(o), Some(n)) if o < n => {
+                    self.events.push(CollisionEvent::Stopped(o.0, o.1));
+                    i += 1;
+                }
+                (Some(o), None) => {
+                    self.events.push(CollisionEvent::Stopped(o.0, o.1));
+                    i += 1;
+                }
+                (_, Some(n)) => {
+                    self.events.push(CollisionEvent::Started(n.0, n.1));
+                    j += 1;
+                }
+                (None, None) => break,
+            }
+        }
+        self.touching = touching;
+    }
+}
+
+fn ordered(a: BodyHandle, b: BodyHandle) -> (BodyHandle, BodyHandle) {
+    if a <= b { (a, b) } else { (b, a) }
+}
+
+fn shape_id(collider: &Collider) -> usize {
+    std::sync::Arc::as_ptr(&collider.shape.0) as *const () as usize
+}
+
+/// Whether the pair's manifolds can be kept: computed before, for the same shapes and
+/// prediction, and the relative pose moved less than the reuse tolerances since.
+fn reusable(
+    state: &PairState,
+    pos12: &Pose,
+    shapes: (usize, usize),
+    settings: &CollideSettings,
+) -> bool {
+    state.computed.as_ref().is_some_and(|c| {
+        c.prediction == settings.prediction
+            && c.shapes == shapes
+            && c.pos12.translation.distance(pos12.translation) < settings.reuse_linear
+            && c.pos12.rotation.angle_between(pos12.rotation) < settings.reuse_angular
+    })
+}
+
+/// The relative pose of a manifold's two sub-shapes (compound parts carry their own frames).
+fn manifold_pos12(m: &Manifold, pos12: &Pose) -> Pose {
+    let sub1 = m.subshape_pos1().copied().unwrap_or(Pose::IDENTITY);
+    let sub2 = m.subshape_pos2().copied().unwrap_or(Pose::IDENTITY);
+    sub1.inv_mul(&(pos12 * sub2))
+}
+
+/// Recomputes a pair's manifolds with parry, reduces each to four points and carries the
+/// impulses over by feature id.
+fn compute(state: &mut PairState, c1: &Collider, c2: &Collider, pos12: &Pose, prediction: f32) {
+    type Key = (u32, u32, PackedFeatureId, PackedFeatureId);
+    let old: Vec<(Key, Vec3)> = state
+        .manifolds
+        .iter()
+        .flat_map(|m| {
+            m.points
+                .iter()
+                .map(move |p| ((m.subshape1, m.subshape2, p.fid1, p.fid2), p.data.impulse))
+        })
+        .collect();
+    let result = DefaultQueryDispatcher.contact_manifolds(
+        pos12,
+        &*c1.shape.0,
+        &*c2.shape.0,
+        prediction,
+        &mut state.manifolds,
+        &mut state.workspace,
+    );
+    if result.is_err() {
+        // An unsupported pair (two half-spaces): no contact, by definition of the shapes.
+        state.manifolds.clear();
+    }
+    cross_check_depth(state, c1, c2, pos12, prediction);
+    for m in &mut state.manifolds {
+        // parry's polygonal clipping can return points of a feature far beyond the prediction
+        // distance (a capsule's far end under a box face, for one); they are no contacts.
+        m.points.retain(|p| p.dist <= prediction);
+        reduce_manifold(&mut m.points, m.local_n1);
+        let (s1, s2) = (m.subshape1, m.subshape2);
+        for p in &mut m.points {
+            let key = (s1, s2, p.fid1, p.fid2);
+            p.data.impulse = old
+                .iter()
+                .find(|(k, _)| *k == key)
+                .map_or(Vec3::ZERO, |(_, i)| *i);
+        }
+    }
+    state.computed = Some(Computed {
+        pos12: *pos12,
+        prediction,
+        shapes: (shape_id(c1), shape_id(c2)),
+    });
+}
+
+/// The deepest penetration a manifold list reports (−∞ when it has no point).
+fn max_penetration(manifolds: &[Manifold]) -> f32 {
+    manifolds
+        .iter()
+        .flat_map(|m| &m.points)
+        .map(|p| -p.dist)
+        .fold(f32::NEG_INFINITY, f32::max)
+}
+
+/// An upper bound of the penetration depth of two convex shapes: their overlap along the line
+/// joining their origins (the depth is the overlap along the *best* axis, so along any axis the
+/// overlap bounds it from above). `None` when a shape has no support map or the origins meet.
+fn depth_bound(c1: &Collider, c2: &Collider, pos12: &Pose) -> Option<f32> {
+    let s1 = c1.shape.as_support_map()?;
+    let s2 = c2.shape.as_support_map()?;
+    let u = pos12.translation.try_normalize()?;
+    // Extent of shape 1 along +u, and of shape 2 along −u, both in shape 1's frame.
+    let max1 = u.dot(s1.local_support_point(u));
+    let min2 = u.dot(s2.support_point(pos12, -u));
+    let max2 = u.dot(s2.support_point(pos12, u));
+    let min1 = u.dot(s1.local_support_point(-u));
+    Some((max1 - min2).min(max2 - min1))
+}
+
+/// Works around parry 0.31's GJK/EPA on exactly aligned convex polytopes and cylinders (a stack
+/// of identical hulls or cylinders): in one argument order it returns a diagonal normal and a
+/// depth of ~0.7 m for a 1 cm overlap, in the other the right answer. The reported depth is
+/// checked against the overlap along the line of centres, an upper bound of the true depth;
+/// only when it exceeds it is the query repeated with the shapes exchanged, and the shallower
+/// answer kept (the depth is the *smallest* separating translation).
+fn cross_check_depth(
+    state: &mut PairState,
+    c1: &Collider,
+    c2: &Collider,
+    pos12: &Pose,
+    prediction: f32,
+) {
+    let depth = max_penetration(&state.manifolds);
+    if depth <= 0.0 {
+        return;
+    }
+    let Some(bound) = depth_bound(c1, c2, pos12) else {
+        return;
+    };
+    if depth <= bound + 1e-3 + 0.01 * bound.abs() {
+        return;
+    }
+    let mut flipped: Vec<Manifold> = Vec::new();
+    let mut workspace = None;
+    let result = DefaultQueryDispatcher.contact_manifolds(
+        &pos12.inverse(),
+        &*c2.shape.0,
+        &*c1.shape.0,
+        prediction,
+        &mut flipped,
+        &mut workspace,
+    );
+    if result.is_ok() && !flipped.is_empty() && max_penetration(&flipped) < depth {
+        state.manifolds = flipped.into_iter().map(swap_shapes).collect();
+    }
+}
+
+/// The same manifold seen with its two shapes exchanged.
+fn swap_shapes(mut m: Manifold) -> Manifold {
+    std::mem::swap(&mut m.local_n1, &mut m.local_n2);
+    std::mem::swap(&mut m.subshape1, &mut m.subshape2);
+    if let Some(poses) = m.subshape_poses.as_mut() {
+        std::mem::swap(&mut poses.pos1, &mut poses.pos2);
+    }
+    for p in &mut m.points {
+        std::mem::swap(&mut p.local_p1, &mut p.local_p2);
+        std::mem::swap(&mut p.fid1, &mut p.fid2);
+    }
+    m
+}

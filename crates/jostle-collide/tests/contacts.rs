@@ -1,0 +1,338 @@
+//! Contact generation per shape pair, and the B → A normal convention.
+
+mod common;
+
+use common::*;
+use jostle_collide::ShapeDesc;
+use jostle_math::{Quat, Vec3};
+
+/// Shapes whose lowest point is 0.5 m below their centre and highest 0.5 m above it.
+fn shapes() -> Vec<(&'static str, ShapeDesc)> {
+    vec![
+        ("ball", ShapeDesc::Ball { radius: 0.5 }),
+        (
+            "cuboid",
+            ShapeDesc::Cuboid {
+                half_extents: Vec3::splat(0.5),
+            },
+        ),
+        (
+            "capsule",
+            ShapeDesc::Capsule {
+                half_height: 0.3,
+                radius: 0.2,
+            },
+        ),
+        (
+            "cylinder",
+            ShapeDesc::Cylinder {
+                half_height: 0.5,
+                radius: 0.4,
+            },
+        ),
+        ("hull", hull_prism()),
+    ]
+}
+
+/// Checks the contacts of a scene where `upper` rests on `lower` with `depth` of overlap.
+fn check_stack(
+    scene: &Scene,
+    upper: jostle_body::BodyHandle,
+    lower: jostle_body::BodyHandle,
+    depth: f32,
+    what: &str,
+) {
+    let contacts = scene.contacts();
+    assert!(!contacts.is_empty(), "{what}: no contact");
+    assert!(
+        contacts.len() <= 4,
+        "{what}: {} points in one manifold",
+        contacts.len()
+    );
+    for c in contacts {
+        let up = if c.a == upper {
+            assert_eq!(c.b, lower, "{what}");
+            Vec3::Y
+        } else {
+            assert_eq!((c.a, c.b), (lower, upper), "{what}");
+            -Vec3::Y
+        };
+        // B → A: the direction A must move to separate.
+        assert!(
+            c.normal.dot(up) > 0.999,
+            "{what}: normal {} for A = {:?}",
+            c.normal,
+            c.a
+        );
+        assert!(
+            (c.normal.length() - 1.0).abs() < 1e-5,
+            "{what}: normal not unit"
+        );
+        assert!(
+            (c.penetration - depth).abs() < 2e-3,
+            "{what}: penetration {} != {depth}",
+            c.penetration
+        );
+        assert!(
+            (c.point.y - (0.5 - depth / 2.0)).abs() < 0.01,
+            "{what}: point {} not between the surfaces",
+            c.point
+        );
+    }
+}
+
+#[test]
+fn every_convex_pair_touches_with_the_b_to_a_normal() {
+    for (name_a, a) in shapes() {
+        for (name_b, b) in shapes() {
+            for upper_first in [true, false] {
+                let what = format!("{name_a} on {name_b} (upper inserted first: {upper_first})");
+                let mut scene = Scene::new();
+                let (upper, lower) = if upper_first {
+                    let u = scene.dynamic(&a, Vec3::new(0.0, 0.99, 0.0));
+                    (u, scene.dynamic(&b, Vec3::ZERO))
+                } else {
+                    let l = scene.dynamic(&b, Vec3::ZERO);
+                    (scene.dynamic(&a, Vec3::new(0.0, 0.99, 0.0)), l)
+                };
+                scene.step();
+                check_stack(&scene, upper, lower, 0.01, &what);
+            }
+        }
+    }
+}
+
+#[test]
+fn every_convex_shape_touches_a_half_space_and_a_mesh() {
+    for (floor_name, floor) in [("half-space", ground()), ("mesh", mesh_floor())] {
+        for (name, shape) in shapes() {
+            for floor_first in [true, false] {
+                let what = format!("{name} on {floor_name} (floor first: {floor_first})");
+                let mut scene = Scene::new();
+                let (body, fixed) = if floor_first {
+                    let f = scene.fixed(&floor, Vec3::new(0.0, -0.5, 0.0));
+                    (scene.dynamic(&shape, Vec3::new(0.3, -0.01, 0.2)), f)
+                } else {
+                    let b = scene.dynamic(&shape, Vec3::new(0.3, -0.01, 0.2));
+                    (b, scene.fixed(&floor, Vec3::new(0.0, -0.5, 0.0)))
+                };
+                scene.step();
+                let contacts = scene.contacts();
+                assert!(!contacts.is_empty(), "{what}: no contact");
+                for c in contacts {
+                    // The dynamic body is A when the other is fixed.
+                    assert_eq!((c.a, c.b), (body, fixed), "{what}");
+                    assert!(c.normal.dot(Vec3::Y) > 0.999, "{what}: normal {}", c.normal);
+                    assert!(
+                        (c.penetration - 0.01).abs() < 2e-3,
+                        "{what}: penetration {}",
+                        c.penetration
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn separated_shapes_have_no_contact_and_near_ones_a_speculative_one() {
+    let mut scene = Scene::new();
+    let a = scene.dynamic(&ShapeDesc::Ball { radius: 0.5 }, Vec3::new(0.0, 1.01, 0.0));
+    let b = scene.dynamic(&unit_cube(), Vec3::new(0.0, -0.5, 0.0));
+    scene.step();
+    let c = scene.contacts();
+    assert_eq!(c.len(), 1, "a gap of 1 cm is within the 2 cm prediction");
+    assert!(
+        (c[0].penetration + 0.01).abs() < 1e-4,
+        "separation is a negative penetration: {}",
+        c[0].penetration
+    );
+    assert_eq!((c[0].a, c[0].b), (a, b));
+    scene.move_by(a, Vec3::new(0.0, 0.1, 0.0));
+    scene.step();
+    assert!(scene.contacts().is_empty());
+}
+
+#[test]
+fn resting_cube_on_a_half_space_has_four_corner_points() {
+    let mut scene = Scene::new();
+    scene.fixed(&ground(), Vec3::ZERO);
+    let cube = scene.dynamic(&unit_cube(), Vec3::new(2.0, 0.99, -3.0));
+    scene.step();
+    let c = scene.contacts();
+    assert_eq!(c.len(), 4, "{c:#?}");
+    let mut corners: Vec<(i32, i32)> = c
+        .iter()
+        .map(|c| {
+            assert_eq!(c.a, cube);
+            assert!((c.normal - Vec3::Y).length() < 1e-5);
+            assert!((c.penetration - 0.01).abs() < 1e-4, "{}", c.penetration);
+            let local = c.point - Vec3::new(2.0, 0.0, -3.0);
+            assert!(
+                (local.x.abs() - 1.0).abs() < 1e-4 && (local.z.abs() - 1.0).abs() < 1e-4,
+                "{}",
+                c.point
+            );
+            assert!(
+                (c.point.y + 0.005).abs() < 1e-4,
+                "midway between the surfaces: {}",
+                c.point
+            );
+            (local.x.signum() as i32, local.z.signum() as i32)
+        })
+        .collect();
+    corners.sort();
+    assert_eq!(corners, vec![(-1, -1), (-1, 1), (1, -1), (1, 1)]);
+}
+
+#[test]
+fn tilted_cube_touches_with_its_lowest_edge() {
+    let mut scene = Scene::new();
+    scene.fixed(&ground(), Vec3::ZERO);
+    let tilt = Quat::from_rotation_z(30f32.to_radians());
+    // Lowest corners: local (−1, −1, ±1) at height −(sin 30° + cos 30°) = −1.366.
+    let lowest = 30f32.to_radians().sin() + 30f32.to_radians().cos();
+    let edge_x = -30f32.to_radians().cos() + 30f32.to_radians().sin();
+    scene.add(
+        &unit_cube(),
+        Vec3::new(0.0, lowest - 0.01, 0.0),
+        tilt,
+        false,
+    );
+    scene.step();
+    let c = scene.contacts();
+    assert_eq!(c.len(), 2, "{c:#?}");
+    for c in c {
+        assert!(
+            (c.point.x - edge_x).abs() < 1e-3,
+            "point {} off the lowest edge (x = {edge_x})",
+            c.point
+        );
+        assert!((c.point.z.abs() - 1.0).abs() < 1e-3, "{}", c.point);
+        assert!((c.penetration - 0.01).abs() < 1e-3);
+        assert!((c.normal - Vec3::Y).length() < 1e-5);
+    }
+    assert!(c[0].point.z * c[1].point.z < 0.0, "both ends of the edge");
+}
+
+#[test]
+fn ball_on_a_half_space_has_one_point_under_its_centre() {
+    let mut scene = Scene::new();
+    scene.fixed(&ground(), Vec3::ZERO);
+    let ball = scene.dynamic(&ShapeDesc::Ball { radius: 0.5 }, Vec3::new(3.0, 0.49, -2.0));
+    scene.step();
+    let c = scene.contacts();
+    assert_eq!(c.len(), 1);
+    assert_eq!(c[0].a, ball);
+    assert!(
+        (c[0].point - Vec3::new(3.0, -0.005, -2.0)).length() < 1e-4,
+        "{}",
+        c[0].point
+    );
+    assert!((c[0].penetration - 0.01).abs() < 1e-4);
+}
+
+#[test]
+fn box_on_box_gives_a_four_point_manifold() {
+    // One point per pair is why Millington's original cannot stack (DESIGN.md).
+    let mut scene = Scene::new();
+    let lower = scene.fixed(&unit_cube(), Vec3::ZERO);
+    let upper = scene
+        .add(
+            &unit_cube(),
+            Vec3::new(0.2, 1.99, 0.1),
+            Quat::from_rotation_y(0.4),
+            false,
+        )
+        .0;
+    scene.step();
+    let c = scene.contacts();
+    assert_eq!(c.len(), 4, "{c:#?}");
+    for c in c {
+        assert_eq!((c.a, c.b), (upper, lower));
+        assert!((c.normal - Vec3::Y).length() < 1e-4);
+        assert!((c.penetration - 0.01).abs() < 1e-3);
+    }
+}
+
+#[test]
+fn compound_parts_each_touch_in_their_own_frame() {
+    // A dumbbell of two balls, rotated a quarter turn about Y, resting on a half-space.
+    let part = |x: f32| jostle_collide::CompoundPart {
+        shape: ShapeDesc::Ball { radius: 0.5 },
+        position: Vec3::new(x, 0.0, 0.0),
+        rotation: Quat::IDENTITY,
+    };
+    let dumbbell = ShapeDesc::Compound {
+        parts: vec![part(-1.0), part(1.0)],
+    };
+    let mut scene = Scene::new();
+    scene.fixed(&ground(), Vec3::ZERO);
+    scene.add(
+        &dumbbell,
+        Vec3::new(0.0, 0.49, 0.0),
+        Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+        false,
+    );
+    scene.step();
+    let mut c: Vec<_> = scene.contacts().to_vec();
+    assert_eq!(c.len(), 2);
+    c.sort_by(|a, b| a.point.z.total_cmp(&b.point.z));
+    // Local ±X maps to ∓Z under a quarter turn about Y.
+    assert!(
+        (c[0].point - Vec3::new(0.0, -0.005, -1.0)).length() < 1e-3,
+        "{}",
+        c[0].point
+    );
+    assert!(
+        (c[1].point - Vec3::new(0.0, -0.005, 1.0)).length() < 1e-3,
+        "{}",
+        c[1].point
+    );
+    for c in &c {
+        assert!((c.normal - Vec3::Y).length() < 1e-4);
+    }
+}
+
+#[test]
+fn materials_are_mixed() {
+    let mut scene = Scene::new();
+    scene.fixed(&ground(), Vec3::ZERO);
+    scene.dynamic(&ShapeDesc::Ball { radius: 0.5 }, Vec3::new(0.0, 0.49, 0.0));
+    scene.colliders.iter().count();
+    let handles: Vec<_> = scene.colliders.iter().map(|(h, _)| h).collect();
+    scene.colliders.get_mut(handles[0]).unwrap().material =
+        jostle_collide::Material::new(0.25, 0.1);
+    scene.colliders.get_mut(handles[1]).unwrap().material = jostle_collide::Material::new(1.0, 0.7);
+    scene.step();
+    let c = scene.contacts()[0];
+    assert!((c.friction - 0.5).abs() < 1e-6);
+    assert_eq!(c.restitution, 0.7);
+}
+
+#[test]
+fn regression_aligned_hulls_and_cylinders_get_the_axis_normal() {
+    // Cause: parry 0.31's EPA returns a diagonal normal and a ~0.7 m depth for two exactly
+    // aligned hulls (or coaxial cylinders) when the lower one is the first shape of the pair.
+    // The narrow phase checks the depth against the overlap along the line of centres and
+    // repeats the query with the shapes exchanged.
+    let cylinder = ShapeDesc::Cylinder {
+        half_height: 0.5,
+        radius: 0.4,
+    };
+    for shape in [hull_prism(), cylinder] {
+        for overlap in [0.001, 0.01, 0.05] {
+            let mut scene = Scene::new();
+            let lower = scene.dynamic(&shape, Vec3::ZERO);
+            let upper = scene.dynamic(&shape, Vec3::new(0.0, 1.0 - overlap, 0.0));
+            scene.step();
+            check_stack(
+                &scene,
+                upper,
+                lower,
+                overlap,
+                &format!("{shape:?} overlap {overlap}"),
+            );
+        }
+    }
+}

@@ -1,0 +1,162 @@
+//! Manifold persistence: warm-start impulses matched by feature id, and manifold reuse.
+
+mod common;
+
+use common::*;
+use jostle_collide::ShapeDesc;
+use jostle_math::{Quat, Vec3};
+
+/// Stores a distinct impulse per contact, moves `body` by `delta`, updates, and checks every
+/// contact got back the impulse of the contact it continues (the nearest old point).
+fn impulses_follow_points(scene: &mut Scene, body: jostle_body::BodyHandle, delta: Vec3) {
+    scene.step();
+    let before: Vec<(Vec3, Vec3)> = scene
+        .contacts()
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            (
+                c.point,
+                Vec3::new(1.0 + i as f32, 0.1 * i as f32, -0.2 * i as f32),
+            )
+        })
+        .collect();
+    assert!(!before.is_empty());
+    let impulses: Vec<Vec3> = before.iter().map(|b| b.1).collect();
+    scene.narrow.store_impulses(&impulses);
+    assert_eq!(
+        scene
+            .contacts()
+            .iter()
+            .map(|c| c.impulse)
+            .collect::<Vec<_>>(),
+        impulses
+    );
+
+    scene.move_by(body, delta);
+    let stats = scene.step();
+    assert_eq!(
+        stats.manifolds_reused, 0,
+        "a move of {delta} exceeds the reuse tolerance"
+    );
+    assert_eq!(scene.contacts().len(), before.len());
+    for c in scene.contacts() {
+        let nearest = before
+            .iter()
+            .min_by(|a, b| a.0.distance(c.point).total_cmp(&b.0.distance(c.point)))
+            .unwrap();
+        assert_eq!(c.impulse, nearest.1, "point {} lost its impulse", c.point);
+    }
+}
+
+#[test]
+fn impulses_survive_a_small_motion_on_a_half_space() {
+    let mut scene = Scene::new();
+    scene.fixed(&ground(), Vec3::ZERO);
+    let cube = scene.dynamic(&unit_cube(), Vec3::new(0.0, 0.99, 0.0));
+    impulses_follow_points(&mut scene, cube, Vec3::new(1e-3, -1e-3, 5e-4));
+}
+
+#[test]
+fn impulses_survive_a_small_motion_box_on_box() {
+    let mut scene = Scene::new();
+    scene.fixed(&unit_cube(), Vec3::ZERO);
+    let (cube, _) = scene.add(
+        &unit_cube(),
+        Vec3::new(0.3, 1.99, 0.0),
+        Quat::from_rotation_y(0.3),
+        false,
+    );
+    impulses_follow_points(&mut scene, cube, Vec3::new(2e-3, 1e-3, 0.0));
+}
+
+#[test]
+fn impulses_survive_a_small_motion_hull_on_mesh() {
+    let mut scene = Scene::new();
+    scene.fixed(&mesh_floor(), Vec3::ZERO);
+    let hull = scene.dynamic(&hull_prism(), Vec3::new(-3.0, 0.49, 4.0));
+    impulses_follow_points(&mut scene, hull, Vec3::new(1e-3, 0.0, -1e-3));
+}
+
+#[test]
+fn a_new_feature_starts_cold() {
+    let mut scene = Scene::new();
+    scene.fixed(&ground(), Vec3::ZERO);
+    let ball = scene.dynamic(&ShapeDesc::Ball { radius: 0.5 }, Vec3::new(0.0, 0.49, 0.0));
+    scene.step();
+    scene.narrow.store_impulses(&[Vec3::new(3.0, 0.0, 0.0)]);
+    // Lift it out of range: the pair loses its contact, then the new contact has no history.
+    scene.move_by(ball, Vec3::new(0.0, 1.0, 0.0));
+    scene.step();
+    assert!(scene.contacts().is_empty());
+    scene.move_by(ball, Vec3::new(0.0, -1.0, 0.0));
+    scene.step();
+    assert_eq!(scene.contacts()[0].impulse, Vec3::ZERO);
+}
+
+#[test]
+fn nothing_moved_means_reused_manifolds() {
+    let mut scene = Scene::new();
+    scene.fixed(&ground(), Vec3::ZERO);
+    scene.dynamic(&unit_cube(), Vec3::new(0.0, 0.99, 0.0));
+    scene.dynamic(&ShapeDesc::Ball { radius: 0.5 }, Vec3::new(5.0, 0.49, 0.0));
+    let first = scene.step();
+    assert_eq!(first.manifolds_reused, 0);
+    assert_eq!(first.manifolds, 2);
+    let contacts = scene.contacts().to_vec();
+    let second = scene.step();
+    assert_eq!(second.manifolds_reused, 2);
+    assert_eq!(second.contact_points, 5);
+    assert_eq!(scene.contacts(), &contacts[..]);
+}
+
+#[test]
+fn reused_manifolds_follow_the_bodies() {
+    // Two dynamic balls moved together by 10 m: their relative pose is unchanged, so the
+    // manifold is reused, but the world point must move with them.
+    let mut scene = Scene::new();
+    let a = scene.dynamic(&ShapeDesc::Ball { radius: 0.5 }, Vec3::new(0.0, 0.99, 0.0));
+    let b = scene.dynamic(&ShapeDesc::Ball { radius: 0.5 }, Vec3::ZERO);
+    scene.step();
+    let before = scene.contacts()[0];
+    let shift = Vec3::new(10.0, -3.0, 4.0);
+    scene.move_by(a, shift);
+    scene.move_by(b, shift);
+    let stats = scene.step();
+    assert_eq!(stats.manifolds_reused, 1);
+    let after = scene.contacts()[0];
+    assert!(
+        (after.point - (before.point + shift)).length() < 1e-5,
+        "{} vs {}",
+        after.point,
+        before.point + shift
+    );
+    assert!((after.penetration - before.penetration).abs() < 1e-6);
+}
+
+#[test]
+fn reuse_below_tolerance_refreshes_the_depth() {
+    let mut scene = Scene::new();
+    scene.fixed(&ground(), Vec3::ZERO);
+    let cube = scene.dynamic(&unit_cube(), Vec3::new(0.0, 0.99, 0.0));
+    scene.step();
+    scene.move_by(cube, Vec3::new(0.0, -5e-5, 0.0));
+    let stats = scene.step();
+    assert_eq!(stats.manifolds_reused, 1);
+    for c in scene.contacts() {
+        assert!((c.penetration - 0.01005).abs() < 2e-6, "{}", c.penetration);
+    }
+}
+
+#[test]
+fn pairs_that_leave_the_candidate_list_are_dropped() {
+    let mut scene = Scene::new();
+    scene.fixed(&ground(), Vec3::ZERO);
+    let ball = scene.dynamic(&ShapeDesc::Ball { radius: 0.5 }, Vec3::new(0.0, 0.49, 0.0));
+    scene.step();
+    assert_eq!(scene.narrow.pair_count(), 1);
+    scene.move_by(ball, Vec3::new(0.0, 5.0, 0.0));
+    let stats = scene.step();
+    assert_eq!(stats.candidate_pairs, 0);
+    assert_eq!(scene.narrow.pair_count(), 0);
+}
