@@ -38,7 +38,15 @@ mod tests {
     fn free_fall_is_exact_for_semi_implicit_euler() {
         let g = Vec3::new(0.0, -9.81, 0.0);
         let dt = 1.0 / 60.0;
-        let mut bodies = vec![SolverBody::STATIC, SolverBody::new(Vec3::new(0.0, 10.0, 0.0), Quat::IDENTITY, 1.0, Mat3::IDENTITY)];
+        let mut bodies = vec![
+            SolverBody::STATIC,
+            SolverBody::new(
+                Vec3::new(0.0, 10.0, 0.0),
+                Quat::IDENTITY,
+                1.0,
+                Mat3::IDENTITY,
+            ),
+        ];
         bodies[1].linear_velocity = Vec3::new(0.0, 2.0, 0.0);
         let n = 120;
         for _ in 0..n {
@@ -48,7 +56,11 @@ mod tests {
         let nf = n as f64;
         let (dt64, g64) = (dt as f64, 9.81f64);
         let y = 10.0 + 2.0 * nf * dt64 - g64 * dt64 * dt64 * nf * (nf + 1.0) / 2.0;
-        assert!((bodies[1].position.y as f64 - y).abs() < 1e-4, "{} vs {y}", bodies[1].position.y);
+        assert!(
+            (bodies[1].position.y as f64 - y).abs() < 1e-4,
+            "{} vs {y}",
+            bodies[1].position.y
+        );
         assert_eq!(bodies[0], SolverBody::STATIC);
     }
 }

@@ -13,9 +13,12 @@
 
 pub mod contact;
 pub mod integrate;
+pub mod millington;
 pub mod resolver;
 pub mod solver_body;
+pub mod synthetic;
 
 pub use contact::Contact;
+pub use millington::{MillingtonResolver, MillingtonSettings};
 pub use resolver::{ResolveStats, Resolver, StepContext};
 pub use solver_body::{STATIC_BODY, SolverBody};

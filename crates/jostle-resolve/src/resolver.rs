@@ -50,9 +50,8 @@ pub struct ResolveStats {
 ///   caller detects and quarantines.
 /// - Deterministic: the same inputs give bit-identical outputs.
 ///
-/// The Millington resolver resolves contacts and then integrates (Cyclone's frame order,
-/// shifted so detection comes first); the soft-step resolver integrates inside its substeps.
-/// Both fit this one method.
+/// The Millington resolver integrates velocities, resolves, then integrates poses; a
+/// substepping resolver integrates inside its substeps. Both fit this one method.
 pub trait Resolver: Send {
     /// Short stable name (`"millington"`, `"soft-step"`), as used on the command line.
     fn name(&self) -> &'static str;

@@ -1,0 +1,232 @@
+//! The Millington resolver: the seed lecture's contact resolution (Millington, *Game Physics
+//! Engine Development*, ch. 14–16), faithful to Cyclone where Cyclone is right and fixed where it
+//! is wrong (DESIGN.md, "Resolver 1: Millington").
+//!
+//! One step is a linear pipeline:
+//! 0. integrate gravity into velocities ([`crate::integrate::integrate_velocities`]);
+//! 1. [`prepare`] every contact once: contact basis, lever arms, closing velocity in contact
+//!    space, desired velocity change (micro-collision rule);
+//! 2. split the contacts into independent islands ([`islands`]);
+//! 3. the **position pass**: per island, worst penetration first, nonlinear (or linear)
+//!    projection ([`position`]), updating the penetration of every contact sharing a body;
+//! 4. the **velocity pass**: per island, worst velocity change first (the desired normal
+//!    change, or the sliding speed of a contact whose friction can still act), an impulse per
+//!    pick ([`velocity`]), updating the closing velocity of every contact sharing a body;
+//! 5. integrate the resolved velocities into poses
+//!    ([`crate::integrate::integrate_positions`]).
+//!
+//! Speculative contacts (negative penetration, within the collision layer's prediction margin)
+//! take part only when their gap closes within the step (see [`desired_delta_velocity`]), so
+//! resting contacts are found before they overlap and nothing bounces before it touches.
+//!
+//! Fixes of the original (Cyclone / the lecture), each behind a regression test in
+//! `tests/fixes.rs` (the contact-basis one in `jostle-math`):
+//! - both bodies immovable (total inertia 0): no division by zero ([`velocity`],
+//!   [`position`]);
+//! - the dynamic-friction denominator is guarded and the normal impulse clamped to a push
+//!   ([`velocity::coulomb_accumulated`]);
+//! - **friction creep**: the lecture tests Coulomb against each pick's own normal impulse and
+//!   picks contacts by their normal velocity change alone, so a resting box's sliding was
+//!   never fully removed (a box on a 10° slope with μ = 0.5 crept 0.136 m in 5 s, ≈ g·sinθ·dt
+//!   per step; on flat ground it drifted ~6 mm in 10 s). Here Coulomb is tested against the
+//!   contact's impulse accumulated over the step ([`velocity::coulomb_accumulated`]) and a
+//!   contact whose friction can still act is also picked for its sliding speed
+//!   ([`velocity::velocity_key`]). μ = 0 contacts keep the frictionless path.
+//!
+//! The worst contact is found with an indexed max-heap and a body → contacts adjacency
+//! ([`PickStrategy::Heap`], O(degree · log n) per pick) or by Cyclone's rescan
+//! ([`PickStrategy::LinearScan`], O(n) per pick); both give bit-identical results.
+//!
+//! In: solver bodies and contacts. Out: moved bodies, and each contact's applied impulse and
+//! remaining penetration. Depends on `jostle-math` alone.
+
+// `!(x > 0.0)` is deliberate throughout: it is true for NaN, so a non-finite inertia or key
+// takes the "do nothing" branch instead of dividing by it.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod change;
+pub mod islands;
+mod passes;
+pub mod position;
+pub mod prepare;
+pub mod priority_queue;
+pub mod settings;
+pub mod velocity;
+mod worst_first;
+
+pub use change::{BodyChange, NO_BODY};
+pub use position::{
+    PenetrationMoves, apply_moves, linear_moves, nonlinear_moves, resolve_penetration,
+    update_penetration,
+};
+pub use prepare::{PreparedContact, desired_delta_velocity, prepare};
+pub use priority_queue::IndexedMaxHeap;
+pub use settings::{IterationBudget, MillingtonSettings, PickStrategy, Projection};
+pub use velocity::{
+    DYNAMIC_FRICTION_MIN_RESPONSE, FRICTION_CAPACITY_TOLERANCE, FrictionPick, apply_impulse,
+    contact_impulse, coulomb, coulomb_accumulated, friction_impulse, friction_pick,
+    frictionless_impulse, has_friction_capacity, impulse_matrix, reopen_friction, resolve_velocity,
+    update_velocity, velocity_change_per_unit_impulse, velocity_key,
+};
+
+use crate::integrate::{integrate_positions, integrate_velocities};
+use crate::{Contact, ResolveStats, Resolver, SolverBody, StepContext};
+use islands::Islands;
+use passes::{PositionPass, VelocityPass};
+use std::time::Instant;
+use worst_first::{Stamps, run_heap, run_linear_scan};
+
+/// The Millington resolver (see the module docs). Holds its settings and scratch buffers that
+/// are reused from step to step; it keeps no physical state between steps (it does not warm
+/// start), so swapping it in or out mid-simulation is safe.
+#[derive(Clone, Debug, Default)]
+pub struct MillingtonResolver {
+    /// The settings used by the next step; change them freely between steps.
+    pub settings: MillingtonSettings,
+    prepared: Vec<PreparedContact>,
+    islands: Islands,
+    heap: IndexedMaxHeap,
+    stamps: Stamps,
+}
+
+impl MillingtonResolver {
+    /// A resolver with the given settings.
+    pub fn new(settings: MillingtonSettings) -> Self {
+        Self {
+            settings,
+            ..Self::default()
+        }
+    }
+
+    /// The contacts as the last step prepared and resolved them (same order as its input):
+    /// final closing velocities, desired velocity changes and penetrations, for diagnostics.
+    pub fn prepared(&self) -> &[PreparedContact] {
+        &self.prepared
+    }
+
+    /// Steps 1–4 of the module docs without integration: prepares the contacts, runs the
+    /// position and velocity passes island by island, and writes each contact's applied
+    /// impulse (contact space, on A) and remaining penetration. [`Resolver::step`] is this
+    /// followed by integration. `dt` is the step length the bodies' `last_acceleration` was
+    /// integrated over.
+    pub fn resolve_contacts(
+        &mut self,
+        bodies: &mut [SolverBody],
+        contacts: &mut [Contact],
+        dt: f32,
+    ) -> ResolveStats {
+        let mut stats = ResolveStats::default();
+        let settings = &self.settings;
+
+        let start = Instant::now();
+        self.prepared.clear();
+        self.prepared.extend(contacts.iter().map(|c| {
+            prepare(c, bodies, dt, settings.velocity_limit)
+                .unwrap_or_else(|| PreparedContact::inert(c.penetration))
+        }));
+        self.islands.build(&self.prepared, bodies.len());
+        self.heap.reset(contacts.len());
+        self.stamps.reset(contacts.len());
+        stats.islands = self.islands.len() as u32;
+        stats.prepare_time = start.elapsed();
+
+        let start = Instant::now();
+        let mut pass = PositionPass {
+            contacts: &mut self.prepared,
+            bodies,
+            settings,
+        };
+        for i in 0..self.islands.len() {
+            let island = self.islands.island(i);
+            let budget = settings.position_iterations.for_contacts(island.len());
+            let eps = settings.position_epsilon;
+            stats.position_iterations += match settings.pick {
+                PickStrategy::Heap => run_heap(
+                    &mut pass,
+                    island,
+                    &self.islands,
+                    &mut self.heap,
+                    &mut self.stamps,
+                    eps,
+                    budget,
+                ),
+                PickStrategy::LinearScan => run_linear_scan(&mut pass, island, eps, budget),
+            };
+        }
+        stats.position_time = start.elapsed();
+
+        let start = Instant::now();
+        // Speculative contacts: the gap left after the position pass decides how much closing
+        // speed the contact tolerates this step.
+        for p in &mut self.prepared {
+            p.gap_velocity = (-p.penetration).max(0.0) / dt;
+            p.desired_delta_velocity = desired_delta_velocity(
+                p.velocity.x,
+                p.acc_velocity,
+                p.restitution,
+                settings.velocity_limit,
+                p.gap_velocity,
+            );
+        }
+        let mut pass = VelocityPass {
+            contacts: &mut self.prepared,
+            bodies,
+            velocity_limit: settings.velocity_limit,
+            velocity_epsilon: settings.velocity_epsilon,
+            picked: u32::MAX,
+        };
+        for i in 0..self.islands.len() {
+            let island = self.islands.island(i);
+            let budget = settings.velocity_iterations.for_contacts(island.len());
+            let eps = settings.velocity_epsilon;
+            stats.velocity_iterations += match settings.pick {
+                PickStrategy::Heap => run_heap(
+                    &mut pass,
+                    island,
+                    &self.islands,
+                    &mut self.heap,
+                    &mut self.stamps,
+                    eps,
+                    budget,
+                ),
+                PickStrategy::LinearScan => run_linear_scan(&mut pass, island, eps, budget),
+            };
+        }
+        for (c, p) in contacts.iter_mut().zip(&self.prepared) {
+            c.impulse = p.impulse;
+            c.penetration = p.penetration;
+        }
+        stats.velocity_time = start.elapsed();
+        stats
+    }
+}
+
+impl Resolver for MillingtonResolver {
+    fn name(&self) -> &'static str {
+        "millington"
+    }
+
+    /// Integrates gravity into velocities, resolves contacts
+    /// ([`MillingtonResolver::resolve_contacts`]), then integrates the resolved velocities into
+    /// poses. Cyclone's frame is integrate (velocity then pose), detect, resolve; here detection
+    /// comes first and the pose integration last, so a body is moved by the velocity the
+    /// resolver left it, never by one that still drives it into a contact, and the micro-
+    /// collision rule's v_acc is the velocity this step's integration just added, as in Cyclone.
+    /// Contacts' `impulse` is overwritten with the impulse of this step (this resolver does not
+    /// warm start) and `penetration` with the penetration the position pass left.
+    fn step(
+        &mut self,
+        bodies: &mut [SolverBody],
+        contacts: &mut [Contact],
+        ctx: &StepContext,
+    ) -> ResolveStats {
+        let start = Instant::now();
+        integrate_velocities(bodies, ctx.gravity, ctx.dt);
+        let velocities_time = start.elapsed();
+        let mut stats = self.resolve_contacts(bodies, contacts, ctx.dt);
+        let start = Instant::now();
+        integrate_positions(bodies, ctx.dt);
+        stats.integrate_time = velocities_time + start.elapsed();
+        stats
+    }
+}

@@ -1,0 +1,422 @@
+//! Velocity resolution of one contact: the impulse that gives the desired normal velocity
+//! change (frictionless 1D when μ = 0, else the full 3×3 contact-space impulse with the
+//! static/dynamic Coulomb test), applying it to both bodies, and updating a neighbour's closing
+//! velocity afterwards. Seed lecture: "Velocity Change by Unit Impulse" through "Computing
+//! Impulse"; Millington ch. 14–15.
+//!
+//! Four defects of Cyclone's `calculateFrictionImpulse`/`calculateFrictionlessImpulse` (and
+//! of the lecture's velocity pass) are fixed here, each with a regression test: a zero total
+//! inertia (both bodies immovable) divides by zero; the dynamic-friction denominator
+//! K₀₀ + μ(K₀₁ŷ + K₀₂ẑ) can approach zero or go negative (friction coupling that reduces the
+//! normal response), giving unbounded or pulling impulses; the normal impulse is never
+//! clamped, so a contact can pull; and the Coulomb test limits each pick by its own normal
+//! impulse while picks follow the normal velocity change alone, so resting boxes creep down
+//! slopes and drift on flat ground. The last is fixed by testing Coulomb against the impulse
+//! the contact accumulated this step ([`coulomb_accumulated`], with the normal clamp on that
+//! total) and by keying picks on the sliding speed too while friction can still act
+//! ([`velocity_key`]).
+
+use super::change::{BodyChange, NO_BODY};
+use super::prepare::{PreparedContact, desired_delta_velocity};
+use crate::SolverBody;
+use jostle_math::{Mat3, Vec3, skew};
+
+/// When friction coupling would leave less than this fraction of the frictionless normal
+/// response K₀₀ per unit normal impulse, the dynamic-friction coefficient used for this pick is
+/// reduced until exactly this fraction remains. This bounds the normal impulse at
+/// `desired / (0.25 · K₀₀)`, four times the frictionless one, and keeps the tangential impulse
+/// inside the friction cone. Cyclone divides by the raw denominator, which may be ~0 or < 0.
+pub const DYNAMIC_FRICTION_MIN_RESPONSE: f32 = 0.25;
+
+/// The lecture's Δq̇_t: velocity change along the normal per unit impulse along the normal,
+/// Σ 1/m + ((I⁻¹(r×n))×r)·n over the moving sides (computed once by
+/// [`super::prepare::prepare`]).
+#[inline]
+pub fn velocity_change_per_unit_impulse(p: &PreparedContact) -> f32 {
+    p.normal_inertia
+}
+
+/// The contact-space matrix K mapping a contact-space impulse on A to the change of A's
+/// closing velocity relative to B (seed lecture, "Computing Impulse"):
+/// K = Mᵀ (Σ −[r]× I⁻¹ [r]×) M + (Σ 1/m) 𝟙, summed over the moving sides, M the basis.
+pub fn impulse_matrix(p: &PreparedContact, bodies: &[SolverBody]) -> Mat3 {
+    let mut angular = Mat3::ZERO;
+    let mut inv_mass = 0.0;
+    for side in 0..2 {
+        let Some(b) = side_body(p, bodies, side) else {
+            continue;
+        };
+        inv_mass += b.inv_mass;
+        if b.rotates() {
+            let to_torque = skew(p.r[side]);
+            angular -= to_torque * b.inv_inertia * to_torque;
+        }
+    }
+    let mut k = p.basis.transpose() * angular * p.basis;
+    k.x_axis.x += inv_mass;
+    k.y_axis.y += inv_mass;
+    k.z_axis.z += inv_mass;
+    k
+}
+
+/// The frictionless impulse (contact space): (Δv / Δq̇_t, 0, 0), clamped to a push. Zero when
+/// the contact cannot be resolved (total inertia zero) or would need to pull.
+pub fn frictionless_impulse(p: &PreparedContact) -> Vec3 {
+    let k00 = p.normal_inertia;
+    if !(k00 > 0.0) {
+        // Fix: Cyclone divides by zero here when both bodies are immovable.
+        return Vec3::ZERO;
+    }
+    let g = p.desired_delta_velocity / k00;
+    if g > 0.0 {
+        Vec3::new(g, 0.0, 0.0)
+    } else {
+        Vec3::ZERO
+    }
+}
+
+/// The impulse with friction (contact space) that a pick of `p` applies: solve
+/// K g = (Δv, −v_y, −v_z) for the impulse that gives the desired normal change and kills the
+/// sliding velocity (seed lecture, "Computing Impulse"), then limit the step's **total**
+/// impulse `p.impulse + g` with [`coulomb_accumulated`]. Falls back to
+/// [`frictionless_impulse`] when K is singular (a body that rotates but cannot translate) or
+/// the contact cannot be resolved.
+///
+/// A contact that has applied no normal impulse this step and wants none (Δv ≤ 0) has no
+/// friction to give: the impulse is zero. When it has, a negative desired normal change (it
+/// separates, or its restitution target is already met) is replaced by 0 in the solve: such a
+/// contact is picked only for its sliding ([`velocity_key`]), and friction must not pull it
+/// shut or undo its bounce; it keeps its normal velocity instead. With Δv > 0 and no impulse
+/// yet this is exactly the lecture's procedure.
+pub fn friction_impulse(p: &PreparedContact, bodies: &[SolverBody]) -> Vec3 {
+    friction_pick(p, bodies).applied
+}
+
+/// What one friction pick does: the impulse it applies and whether the contact's friction is
+/// then saturated (see [`PreparedContact::friction_saturated`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrictionPick {
+    /// Impulse the pick applies, contact space, on A (N·s).
+    pub applied: Vec3,
+    /// Whether the step's total impulse ended on the edge of the friction cone (dynamic
+    /// friction, or static to within [`FRICTION_CAPACITY_TOLERANCE`]) or no friction could be
+    /// applied.
+    pub saturated: bool,
+}
+
+/// [`friction_impulse`] with the saturation flag the velocity pass records.
+pub fn friction_pick(p: &PreparedContact, bodies: &[SolverBody]) -> FrictionPick {
+    // Nothing here can ever remove sliding: report saturation so the pass does not re-pick.
+    let no_friction = |applied| FrictionPick {
+        applied,
+        saturated: true,
+    };
+    if !(p.normal_inertia > 0.0) {
+        return no_friction(Vec3::ZERO);
+    }
+    let k = impulse_matrix(p, bodies);
+    let det = k.determinant();
+    let scale = k.x_axis.x * k.y_axis.y * k.z_axis.z;
+    if !(det.abs() > 1e-6 * scale) {
+        return no_friction(frictionless_impulse(p));
+    }
+    if !(p.desired_delta_velocity > 0.0) && !(p.impulse.x > 0.0) {
+        // No normal impulse this step and none wanted: no friction to give.
+        return no_friction(Vec3::ZERO);
+    }
+    let desired = if p.desired_delta_velocity < 0.0 {
+        0.0
+    } else {
+        p.desired_delta_velocity
+    };
+    let target = Vec3::new(desired, -p.velocity.y, -p.velocity.z);
+    let g = k.inverse() * target;
+    coulomb_accumulated(p.impulse, g, k, desired, p.friction, p.velocity)
+}
+
+/// The seed lecture's static/dynamic Coulomb test ("Friction as Impulses") for a single pick
+/// with nothing accumulated: [`coulomb_accumulated`] with a zero accumulated impulse, returning
+/// the impulse to apply. Kept as the lecture's formula (and Cyclone's, with its fixes).
+/// The sliding direction is not known here, so dynamic friction takes g's planar direction,
+/// as Cyclone does.
+pub fn coulomb(g: Vec3, k: Mat3, desired: f32, mu: f32) -> Vec3 {
+    coulomb_accumulated(Vec3::ZERO, g, k, desired, mu, Vec3::ZERO).applied
+}
+
+/// Below this sliding speed (m/s) the sliding direction is taken as undefined and dynamic
+/// friction falls back to the planar direction of the stop-dead impulse.
+pub const SLIDING_DIRECTION_MIN_SPEED: f32 = 1e-6;
+
+/// The static/dynamic Coulomb test of the seed lecture ("Friction as Impulses"), applied to the
+/// contact's **total impulse of this step**: `accumulated` (what earlier picks of this contact
+/// applied) plus `g`, the impulse this pick would apply to stop the contact dead (solved with
+/// `k` for the normal change `desired`). With g_t = accumulated + g:
+/// - static: if |g_t,planar| ≤ μ·g_t,x, the total is inside the friction cone and `g` is
+///   applied as solved;
+/// - dynamic: otherwise the total tangential impulse is μ·g_t,x along d̂, the direction
+///   opposite the contact's `sliding` velocity (contact space, y and z), or g_t,planar's
+///   direction when the contact is not sliding (Cyclone always uses the latter), and the total normal X is re-solved so this pick still changes the normal velocity by
+///   `desired` (Cyclone's re-solve, shifted by what is already applied):
+///   X = (desired + (K·accumulated)ₓ) / (K₀₀ + μ(K₀₁d̂_y + K₀₂d̂_z)), with the denominator
+///   guarded by [`DYNAMIC_FRICTION_MIN_RESPONSE`];
+/// - the total normal impulse is clamped to ≥ 0 (accumulated clamping: a later pick may
+///   reduce an earlier push, never make the total pull); a zero normal leaves no friction.
+///
+/// Returns the pick's impulse g_t′ − accumulated, and whether the result is saturated
+/// (dynamic, a zero total, or static within [`FRICTION_CAPACITY_TOLERANCE`] of the cone's
+/// edge). A non-finite result applies nothing.
+///
+/// Why the total and not the pick alone (fix of the original): the lecture limits each pick's
+/// tangential impulse by μ times *that pick's* normal impulse. Resolved one corner at a time,
+/// a resting box's corners each get a small normal impulse per pick, so their friction could
+/// never hold the box, and once the normal velocities were resolved nothing removed the
+/// remaining sliding: a box resting on a 10° slope with μ = 0.5 crept by ≈ g·sinθ·dt per step
+/// (0.136 m in 5 s at 60 Hz). The friction a contact may apply in a step is μ times the normal
+/// impulse it applied in that step, which is what this test enforces. With a zero
+/// `accumulated` it is exactly the lecture's single-pick test.
+pub fn coulomb_accumulated(
+    accumulated: Vec3,
+    g: Vec3,
+    k: Mat3,
+    desired: f32,
+    mu: f32,
+    sliding: Vec3,
+) -> FrictionPick {
+    let total = accumulated + g;
+    if !total.is_finite() {
+        return FrictionPick {
+            applied: Vec3::ZERO,
+            saturated: true,
+        };
+    }
+    let planar = (total.y * total.y + total.z * total.z).sqrt();
+    let cone = mu * total.x;
+    if planar <= cone {
+        // Static (total.x ≥ 0 here): the solved impulse is applied as it is. Saturated when
+        // it ends on the cone's edge (to round-off), where turning is all friction can still do.
+        return FrictionPick {
+            applied: g,
+            saturated: !(cone - planar > FRICTION_CAPACITY_TOLERANCE * cone),
+        };
+    }
+    let out = if planar > 0.0 {
+        // Fix: dynamic friction opposes the sliding velocity, f = −v̂_planar·μ·|r| (the
+        // lecture's own "Dynamic Friction" slide). Cyclone points it along the planar part of
+        // the stop-dead impulse K⁻¹·Δv instead, which rotational coupling tilts away from the
+        // sliding direction: about 31° at a cube's corner, so a sliding box felt only
+        // cos 31° ≈ 0.86 of μ·N (a box on a 35° slope with μ = 0.3 slid 10% too fast).
+        // Only a contact that is truly sliding has a direction to oppose: one whose sliding
+        // is faster than the planar velocity change the cone-limited impulse can make. A
+        // resting corner that leaves the cone only through rotational coupling keeps Cyclone's
+        // direction, the better approximation of the static solution there.
+        let speed = (sliding.y * sliding.y + sliding.z * sliding.z).sqrt();
+        let capacity = 0.5 * (k.y_axis.y + k.z_axis.z) * mu * total.x.max(0.0);
+        let (dy, dz) = if speed > capacity.max(SLIDING_DIRECTION_MIN_SPEED) {
+            (-sliding.y / speed, -sliding.z / speed)
+        } else {
+            (total.y / planar, total.z / planar)
+        };
+        let k00 = k.x_axis.x;
+        // Row 0 of K: how a tangential impulse changes the normal velocity.
+        let coupling = k.y_axis.x * dy + k.z_axis.x * dz;
+        let floor = DYNAMIC_FRICTION_MIN_RESPONSE * k00;
+        let mu_eff = if k00 + mu * coupling < floor {
+            // coupling < 0 here (k00 > floor); the largest μ' ≤ μ with denominator ≥ floor.
+            ((k00 - floor) / -coupling).clamp(0.0, mu)
+        } else {
+            mu
+        };
+        // Normal velocity change the accumulated impulse already made; the pick applies
+        // (X, μ′X·d̂) − accumulated, whose normal change must be `desired`.
+        let already = k00 * accumulated.x + k.y_axis.x * accumulated.y + k.z_axis.x * accumulated.z;
+        let gx = (desired + already) / (k00 + mu_eff * coupling);
+        Vec3::new(gx, mu_eff * gx * dy, mu_eff * gx * dz)
+    } else {
+        // No sliding to kill and a pulling total normal: clamped to zero below.
+        total
+    };
+    if !out.is_finite() {
+        return FrictionPick {
+            applied: Vec3::ZERO,
+            saturated: true,
+        };
+    }
+    // Fix: Cyclone never clamps, so a separating contact or a coupled solve could pull. The
+    // clamp is on the step's total (accumulated clamping).
+    let out = if out.x > 0.0 { out } else { Vec3::ZERO };
+    FrictionPick {
+        applied: out - accumulated,
+        saturated: true,
+    }
+}
+
+/// Relative tolerance of the friction-capacity test: a static result whose total tangential
+/// impulse is within this fraction of μ × its total normal impulse counts as saturated
+/// ([`coulomb_accumulated`]), so round-off on the cone's edge never makes a contact worth
+/// picking again.
+pub const FRICTION_CAPACITY_TOLERANCE: f32 = 1e-4;
+
+/// Whether a pick of `p` could still remove sliding velocity with friction in this step:
+/// μ > 0, the contact is not [saturated](PreparedContact::friction_saturated), and it has a
+/// normal impulse to carry friction, accumulated (acc_x > 0) or about to be applied (Δv > 0).
+/// The flag encodes the cone test: a pick leaves it set when μ·acc_x − |acc_planar| ≤
+/// [`FRICTION_CAPACITY_TOLERANCE`] · μ·acc_x (dynamic friction, or static on the edge), and
+/// [`reopen_friction`] clears it when the neighbours' picks have turned the sliding since.
+/// μ = 0 contacts never have capacity (no friction work at all).
+pub fn has_friction_capacity(p: &PreparedContact) -> bool {
+    p.friction > 0.0
+        && !p.friction_saturated
+        && (p.impulse.x > 0.0 || p.desired_delta_velocity > 0.0)
+}
+
+/// The velocity pass's pick key of `p` (m/s): how much velocity a pick would remove.
+/// max(desired normal change, planar closing speed) when `p` [has friction
+/// capacity](has_friction_capacity), else the desired normal change (the lecture's key);
+/// −∞ when the contact cannot be resolved (zero normal inertia), NaN stays NaN (never picked).
+///
+/// Why the sliding term (fix of the original): the lecture picks by normal velocity change
+/// alone, so once every corner of a resting box had its normal velocity resolved (below
+/// `velocity_epsilon`), the remaining sliding velocity, including the planar
+/// last_acceleration·dt compensation of the micro-collision rule, was never removed and boxes
+/// crept down slopes (≈ g·sinθ·dt per step) and drifted on flat ground. A contact is picked for
+/// its sliding only while its friction can still act; a pick then either stops the sliding
+/// (static) or saturates the contact (dynamic), so the key drops below the epsilon and the
+/// pass ends by itself, not by its budget.
+#[inline]
+pub fn velocity_key(p: &PreparedContact) -> f32 {
+    if !(p.normal_inertia > 0.0) {
+        return f32::NEG_INFINITY;
+    }
+    let normal = p.desired_delta_velocity;
+    if has_friction_capacity(p) {
+        let sliding = (p.velocity.y * p.velocity.y + p.velocity.z * p.velocity.z).sqrt();
+        if sliding > normal {
+            return sliding;
+        }
+    }
+    normal
+}
+
+/// The impulse the velocity pass applies at `p` (contact space, on A): frictionless when
+/// μ ≤ 0 (no friction work at all, DESIGN.md "skip what a scene does not need"), else
+/// [`friction_impulse`] (against the impulse `p` accumulated so far this step).
+pub fn contact_impulse(p: &PreparedContact, bodies: &[SolverBody]) -> Vec3 {
+    if p.friction > 0.0 {
+        friction_impulse(p, bodies)
+    } else {
+        frictionless_impulse(p)
+    }
+}
+
+/// Applies the contact-space impulse `g` (on A; −g on B) to both bodies (lecture, "Applying the
+/// Impulse"): Δv = g/m, Δω = I⁻¹(r × g), angular work skipped for bodies that do not rotate.
+/// Returns what changed, for the neighbours' updates.
+pub fn apply_impulse(p: &PreparedContact, g: Vec3, bodies: &mut [SolverBody]) -> BodyChange {
+    let world = p.basis * g;
+    let mut change = BodyChange {
+        body: p.body,
+        ..BodyChange::NONE
+    };
+    for side in 0..2 {
+        let index = p.body[side];
+        let Some(b) = (index != NO_BODY)
+            .then(|| bodies.get_mut(index as usize))
+            .flatten()
+        else {
+            change.body[side] = NO_BODY;
+            continue;
+        };
+        let j = if side == 0 { world } else { -world };
+        let dv = j * b.inv_mass;
+        b.linear_velocity += dv;
+        change.linear[side] = dv;
+        if b.rotates() {
+            let dw = b.inv_inertia * p.r[side].cross(j);
+            b.angular_velocity += dw;
+            change.angular[side] = dw;
+        }
+    }
+    change
+}
+
+/// Resolves the velocity of `p`: computes [`contact_impulse`] (with friction,
+/// [`friction_pick`] against the impulse accumulated this step, recording whether the contact's
+/// friction is saturated), adds it to `p.impulse` and applies it. `p`'s own closing velocity is
+/// **not** updated here; the pass updates it like any other contact that shares a body
+/// ([`update_velocity`]), as Cyclone does.
+pub fn resolve_velocity(p: &mut PreparedContact, bodies: &mut [SolverBody]) -> BodyChange {
+    let g = if p.friction > 0.0 {
+        let pick = friction_pick(p, bodies);
+        p.friction_saturated = pick.saturated;
+        pick.applied
+    } else {
+        frictionless_impulse(p)
+    };
+    p.impulse += g;
+    apply_impulse(p, g, bodies)
+}
+
+/// Updates the closing velocity and desired velocity change of `p` after `change` was applied
+/// to bodies it may share: Δv_contact = ±Mᵀ(Δv + Δω × r), + for side A, − for side B.
+/// Returns whether `p` shared a body with the change.
+pub fn update_velocity(p: &mut PreparedContact, change: &BodyChange, velocity_limit: f32) -> bool {
+    let mut touched = false;
+    if let Some(d) = change.point_change(p.body[0], p.r[0]) {
+        p.velocity += p.basis.transpose() * d;
+        touched = true;
+    }
+    if let Some(d) = change.point_change(p.body[1], p.r[1]) {
+        p.velocity -= p.basis.transpose() * d;
+        touched = true;
+    }
+    if touched {
+        p.desired_delta_velocity = desired_delta_velocity(
+            p.velocity.x,
+            p.acc_velocity,
+            p.restitution,
+            velocity_limit,
+            p.gap_velocity,
+        );
+    }
+    touched
+}
+
+/// Keeps [`PreparedContact::friction_saturated`] honest after the pass updated `p`
+/// ([`update_velocity`]) for a pick that shared a body with it. For the contact just picked
+/// (`picked`), records the sliding velocity its saturating pick left. For any other saturated
+/// contact, clears the flag once the picks of its neighbours have changed its sliding velocity
+/// by more than `velocity_epsilon` since it saturated: its friction (at the edge of its cone,
+/// but pointing where the sliding was) can then act again, by turning, and the contact is worth
+/// a pick for its sliding ([`velocity_key`]).
+///
+/// Why (part of the creep fix): corner-by-corner, a corner saturates early while its normal
+/// impulse is small, and the picks of the other corners then turn the box's sliding into a spin
+/// about the one corner that holds; without re-opening, a resting box on a 10° slope still
+/// crept ≈ 0.05 m in 5 s. Re-opening needs a change larger than the epsilon, so as the pass
+/// converges the changes stop re-opening contacts and the pass ends by itself.
+pub fn reopen_friction(p: &mut PreparedContact, picked: bool, velocity_epsilon: f32) {
+    if !p.friction_saturated {
+        return;
+    }
+    let sliding = Vec3::new(0.0, p.velocity.y, p.velocity.z);
+    if picked {
+        p.saturated_sliding = sliding;
+    } else if (sliding - p.saturated_sliding).length() > velocity_epsilon {
+        p.friction_saturated = false;
+    }
+}
+
+/// The body of `side`, when that side moves.
+#[inline]
+fn side_body<'a>(
+    p: &PreparedContact,
+    bodies: &'a [SolverBody],
+    side: usize,
+) -> Option<&'a SolverBody> {
+    let index = p.body[side];
+    if index == NO_BODY {
+        None
+    } else {
+        bodies.get(index as usize)
+    }
+}

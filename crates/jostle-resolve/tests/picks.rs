@@ -1,0 +1,301 @@
+//! The worst-first pick: heap and linear scan agree bit for bit, ties go to the lower contact
+//! index, and a resolution updates its neighbours' penetrations as geometry says it should.
+
+use jostle_math::{Quat, Vec3};
+use jostle_resolve::millington::{
+    IterationBudget, MillingtonResolver, MillingtonSettings, PickStrategy, Projection,
+};
+use jostle_resolve::synthetic::{self, DT, GRAVITY, SyntheticScene, box_body};
+use jostle_resolve::{Contact, ResolveStats, Resolver, STATIC_BODY, SolverBody, StepContext};
+
+/// Every f32 of the bodies and contacts, as bits (so −0.0 ≠ 0.0 and NaN == NaN).
+fn bits(bodies: &[SolverBody], contacts: &[Contact]) -> Vec<u32> {
+    let mut out = Vec::new();
+    for b in bodies {
+        out.extend(b.orientation.to_array().map(f32::to_bits));
+        out.extend(b.position.to_array().map(f32::to_bits));
+        out.extend(b.linear_velocity.to_array().map(f32::to_bits));
+        out.extend(b.angular_velocity.to_array().map(f32::to_bits));
+        out.extend(b.inv_inertia.to_cols_array().map(f32::to_bits));
+    }
+    for c in contacts {
+        out.extend(c.impulse.to_array().map(f32::to_bits));
+        out.push(c.penetration.to_bits());
+    }
+    out
+}
+
+fn run(
+    scene: &SyntheticScene,
+    settings: &MillingtonSettings,
+    steps: usize,
+) -> (Vec<u32>, Vec<ResolveStats>) {
+    let mut bodies = scene.bodies.clone();
+    let mut contacts = scene.contacts.clone();
+    let mut resolver = MillingtonResolver::new(settings.clone());
+    let ctx = StepContext {
+        gravity: GRAVITY,
+        dt: DT,
+    };
+    let mut stats = Vec::new();
+    for _ in 0..steps {
+        stats.push(resolver.step(&mut bodies, &mut contacts, &ctx));
+    }
+    (bits(&bodies, &contacts), stats)
+}
+
+#[test]
+fn heap_and_linear_scan_are_bit_identical() {
+    for (seed, n) in [(1, 40), (2, 300), (3, 1000)] {
+        for projection in [Projection::Nonlinear, Projection::Linear] {
+            let scene = synthetic::random_pile(n, seed);
+            let heap = MillingtonSettings {
+                projection,
+                pick: PickStrategy::Heap,
+                ..Default::default()
+            };
+            let scan = MillingtonSettings {
+                pick: PickStrategy::LinearScan,
+                ..heap.clone()
+            };
+            let (a, sa) = run(&scene, &heap, 3);
+            let (b, sb) = run(&scene, &scan, 3);
+            let picks = |s: &[ResolveStats]| {
+                s.iter()
+                    .map(|s| (s.position_iterations, s.velocity_iterations, s.islands))
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(
+                picks(&sa),
+                picks(&sb),
+                "seed {seed}, {n} contacts, {projection:?}"
+            );
+            assert!(
+                sa[0].position_iterations > 0 && sa[0].velocity_iterations > 0,
+                "the scene must exercise both passes"
+            );
+            assert!(
+                a == b,
+                "seed {seed}, {n} contacts, {projection:?}: results differ"
+            );
+        }
+    }
+    // Stacks: many islands.
+    let scene = synthetic::stacks(500, 6, 9);
+    let heap = MillingtonSettings::default();
+    let scan = MillingtonSettings {
+        pick: PickStrategy::LinearScan,
+        ..heap.clone()
+    };
+    let (a, sa) = run(&scene, &heap, 5);
+    let (b, _) = run(&scene, &scan, 5);
+    assert!(sa[0].islands > 10);
+    assert!(a == b, "stacks: results differ");
+}
+
+#[test]
+fn runs_are_deterministic() {
+    let scene = synthetic::random_pile(500, 11);
+    let settings = MillingtonSettings::default();
+    assert_eq!(run(&scene, &settings, 4).0, run(&scene, &settings, 4).0);
+}
+
+/// One body with two contacts of equal penetration, placed symmetrically about its centre:
+/// which one is resolved first decides the result.
+fn tie_scene(swap: bool) -> (Vec<SolverBody>, Vec<Contact>) {
+    let body = box_body(
+        Vec3::new(0.0, 0.49, 0.0),
+        Quat::IDENTITY,
+        1.0,
+        Vec3::splat(0.5),
+    );
+    let left = Contact::new(1, STATIC_BODY, Vec3::new(-0.5, -0.005, 0.0), Vec3::Y, 0.02);
+    let right = Contact::new(1, STATIC_BODY, Vec3::new(0.5, -0.005, 0.0), Vec3::Y, 0.02);
+    let contacts = if swap {
+        vec![right, left]
+    } else {
+        vec![left, right]
+    };
+    (vec![SolverBody::STATIC, body], contacts)
+}
+
+#[test]
+fn equal_penetrations_resolve_the_lower_index_first() {
+    for pick in [PickStrategy::Heap, PickStrategy::LinearScan] {
+        let settings = MillingtonSettings {
+            pick,
+            position_iterations: IterationBudget {
+                fixed: 1,
+                per_contact: 0,
+            },
+            velocity_iterations: IterationBudget {
+                fixed: 0,
+                per_contact: 0,
+            },
+            ..Default::default()
+        };
+        for swap in [false, true] {
+            let (mut bodies, mut contacts) = tie_scene(swap);
+            let mut resolver = MillingtonResolver::new(settings.clone());
+            let stats = resolver.resolve_contacts(&mut bodies, &mut contacts, DT);
+            assert_eq!(stats.position_iterations, 1);
+            // One pick: contact 0 (whichever point it is) is resolved, contact 1 only updated.
+            assert!(
+                contacts[0].penetration.abs() < 1e-6,
+                "{pick:?} swap {swap}: {:?}",
+                contacts
+            );
+            assert!(
+                contacts[1].penetration > 0.005,
+                "{pick:?} swap {swap}: {:?}",
+                contacts
+            );
+            // The body tipped away from the resolved point: rotation sign follows the index.
+            let spin = bodies[1].orientation.to_scaled_axis().z;
+            let resolved_x = contacts[0].point.x;
+            assert!(
+                spin * resolved_x > 0.0,
+                "rotation {spin} for resolved point x = {resolved_x}"
+            );
+        }
+    }
+}
+
+/// Material point `p` (world, before) of a body that moved from (x0, q0) to (x1, q1).
+fn moved(p: Vec3, x0: Vec3, q0: Quat, x1: Vec3, q1: Quat) -> Vec3 {
+    x1 + (q1 * q0.inverse()) * (p - x0)
+}
+
+#[test]
+fn a_resolution_updates_its_neighbours_like_geometry() {
+    // Two unit boxes: B (body 2) on the ground, A (body 1) on B, both slightly sunk and B's
+    // ground corners at different depths so the deepest one rotates B.
+    let half = Vec3::splat(0.5);
+    let b_body = box_body(Vec3::new(0.0, 0.48, 0.0), Quat::IDENTITY, 1.0, half);
+    let a_body = box_body(Vec3::new(0.1, 1.465, 0.0), Quat::IDENTITY, 2.0, half);
+    let mut bodies = vec![SolverBody::STATIC, a_body, b_body];
+    let depths = [0.04, 0.02, 0.025, 0.02];
+    let mut contacts = Vec::new();
+    for (i, depth) in depths.into_iter().enumerate() {
+        let x = if i & 1 == 0 { -0.5 } else { 0.5 };
+        let z = if i & 2 == 0 { -0.5 } else { 0.5 };
+        contacts.push(Contact::new(
+            2,
+            STATIC_BODY,
+            Vec3::new(x, -depth / 2.0, z),
+            Vec3::Y,
+            depth,
+        ));
+    }
+    for i in 0..4 {
+        // A's bottom corners (x offset 0.1) against B's top face at y = 0.98: depth 0.015.
+        let x = if i & 1 == 0 { -0.4 } else { 0.5 };
+        let z = if i & 2 == 0 { -0.5 } else { 0.5 };
+        contacts.push(Contact::new(
+            1,
+            2,
+            Vec3::new(x, 0.98 - 0.0075, z),
+            Vec3::Y,
+            0.015,
+        ));
+    }
+    let before_bodies = bodies.clone();
+    let before = contacts.clone();
+
+    let settings = MillingtonSettings {
+        position_iterations: IterationBudget {
+            fixed: 1,
+            per_contact: 0,
+        },
+        velocity_iterations: IterationBudget {
+            fixed: 0,
+            per_contact: 0,
+        },
+        ..Default::default()
+    };
+    let mut resolver = MillingtonResolver::new(settings);
+    resolver.resolve_contacts(&mut bodies, &mut contacts, DT);
+    // The deepest contact (0, B's corner) was resolved; A did not move.
+    assert!(contacts[0].penetration.abs() < 1e-6);
+    assert_eq!(bodies[1], before_bodies[1]);
+    assert!(
+        bodies[2].orientation.angle_between(Quat::IDENTITY) > 1e-3,
+        "B must rotate"
+    );
+
+    // Geometry: each contact's two material points move with their bodies; the penetration
+    // changes by −Δp_A·n + Δp_B·n (A moving along n separates).
+    let (b0, b1) = (before_bodies[2], bodies[2]);
+    let mut biggest_change = 0.0f32;
+    for (c0, c1) in before.iter().zip(&contacts) {
+        let n = c0.normal;
+        let dp_b = moved(
+            c0.point,
+            b0.position,
+            b0.orientation,
+            b1.position,
+            b1.orientation,
+        ) - c0.point;
+        // Ground contacts have B as side A; the A-on-B contacts have B as side B.
+        let expected = if c0.a == 2 {
+            c0.penetration - dp_b.dot(n)
+        } else {
+            c0.penetration + dp_b.dot(n)
+        };
+        // First-order rotation in the resolver against the exact rotation here: error ~ θ²·|r|.
+        assert!(
+            (c1.penetration - expected).abs() < 5e-4,
+            "contact {c0:?}: {} vs {expected}",
+            c1.penetration
+        );
+        biggest_change = biggest_change.max((c1.penetration - c0.penetration).abs());
+    }
+    // B's resolved corner rose, so the A-on-B contact right above it got deeper.
+    assert!(
+        contacts[4].penetration > before[4].penetration + 0.005,
+        "{:?}",
+        contacts[4]
+    );
+    assert!(
+        biggest_change > 0.01,
+        "the test must move neighbours measurably"
+    );
+}
+
+#[test]
+fn static_body_does_not_make_contacts_adjacent() {
+    // Two boxes on the ground, not touching each other: two islands, and resolving one never
+    // touches the other's contacts.
+    let half = Vec3::splat(0.5);
+    let mut bodies = vec![
+        SolverBody::STATIC,
+        box_body(Vec3::new(0.0, 0.49, 0.0), Quat::IDENTITY, 1.0, half),
+        box_body(Vec3::new(5.0, 0.45, 0.0), Quat::IDENTITY, 1.0, half),
+    ];
+    let mut contacts = vec![
+        Contact::new(
+            1,
+            STATIC_BODY,
+            Vec3::new(0.0, -0.005, 0.0),
+            Vec3::Y,
+            0.01 + 1e-3,
+        ),
+        Contact::new(STATIC_BODY, 2, Vec3::new(5.0, -0.025, 0.0), -Vec3::Y, 0.05),
+    ];
+    let settings = MillingtonSettings {
+        position_iterations: IterationBudget {
+            fixed: 1,
+            per_contact: 0,
+        },
+        ..Default::default()
+    };
+    let mut resolver = MillingtonResolver::new(settings);
+    let stats = resolver.resolve_contacts(&mut bodies, &mut contacts, DT);
+    assert_eq!(stats.islands, 2);
+    // Each island had its own budget of one pick, so both were resolved.
+    assert_eq!(stats.position_iterations, 2);
+    assert!(
+        contacts.iter().all(|c| c.penetration.abs() < 1e-6),
+        "{contacts:?}"
+    );
+}
