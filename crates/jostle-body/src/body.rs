@@ -28,7 +28,11 @@ pub struct SleepState {
 
 impl Default for SleepState {
     fn default() -> Self {
-        Self { awake: true, can_sleep: true, motion: f32::MAX }
+        Self {
+            awake: true,
+            can_sleep: true,
+            motion: f32::MAX,
+        }
     }
 }
 
@@ -206,7 +210,21 @@ impl RigidBody {
         }
         let inertia_world = self.inv_inertia_world.inverse();
         0.5 * self.mass * self.linear_velocity.length_squared()
-            + 0.5 * self.angular_velocity.dot(inertia_world * self.angular_velocity)
+            + 0.5
+                * self
+                    .angular_velocity
+                    .dot(inertia_world * self.angular_velocity)
+    }
+
+    /// Freezes the body where it is: it becomes fixed (immovable, zero velocity, no forces).
+    /// Used to quarantine a body whose state went non-finite, so it cannot spread NaN.
+    pub fn freeze(&mut self) {
+        let (position, orientation, sleep) = (self.position, self.orientation, self.sleep);
+        *self = Self::fixed().with_pose(position, orientation);
+        self.sleep = SleepState {
+            awake: false,
+            ..sleep
+        };
     }
 
     /// Whether every number in the body's state is finite.
@@ -246,9 +264,15 @@ mod tests {
 
     #[test]
     fn bad_mass_is_rejected() {
-        assert_eq!(RigidBody::dynamic(0.0, Mat3::IDENTITY), Err(MassError::Mass(0.0)));
+        assert_eq!(
+            RigidBody::dynamic(0.0, Mat3::IDENTITY),
+            Err(MassError::Mass(0.0))
+        );
         assert!(RigidBody::dynamic(f32::NAN, Mat3::IDENTITY).is_err());
         assert!(RigidBody::dynamic(1.0, Mat3::ZERO).is_err());
-        assert!(RigidBody::dynamic(1.0, Mat3::from_diagonal(Vec3::new(1.0, f32::INFINITY, 1.0))).is_err());
+        assert!(
+            RigidBody::dynamic(1.0, Mat3::from_diagonal(Vec3::new(1.0, f32::INFINITY, 1.0)))
+                .is_err()
+        );
     }
 }

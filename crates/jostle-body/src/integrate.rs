@@ -54,7 +54,10 @@ mod tests {
             integrate_body(&mut b, g, dt);
             let nf = n as f64;
             let y = 3.0 - 9.81 * (dt as f64).powi(2) * nf * (nf + 1.0) / 2.0;
-            assert!((b.position.y as f64 - y).abs() < 2e-4 * (1.0 + y.abs()), "step {n}");
+            assert!(
+                (b.position.y as f64 - y).abs() < 2e-4 * (1.0 + y.abs()),
+                "step {n}"
+            );
         }
     }
 

@@ -61,11 +61,20 @@ impl BodySet {
         if let Some(index) = self.free.pop() {
             let slot = &mut self.slots[index as usize];
             slot.body = Some(body);
-            BodyHandle { index, generation: slot.generation }
+            BodyHandle {
+                index,
+                generation: slot.generation,
+            }
         } else {
             let index = u32::try_from(self.slots.len()).expect("more than u32::MAX bodies");
-            self.slots.push(Slot { generation: 0, body: Some(body) });
-            BodyHandle { index, generation: 0 }
+            self.slots.push(Slot {
+                generation: 0,
+                body: Some(body),
+            });
+            BodyHandle {
+                index,
+                generation: 0,
+            }
         }
     }
 
@@ -85,13 +94,17 @@ impl BodySet {
     /// The body behind `handle`, or `None` if it is stale or invalid.
     pub fn get(&self, handle: BodyHandle) -> Option<&RigidBody> {
         let slot = self.slots.get(handle.index as usize)?;
-        (slot.generation == handle.generation).then_some(slot.body.as_ref()).flatten()
+        (slot.generation == handle.generation)
+            .then_some(slot.body.as_ref())
+            .flatten()
     }
 
     /// The body behind `handle`, mutably, or `None` if it is stale or invalid.
     pub fn get_mut(&mut self, handle: BodyHandle) -> Option<&mut RigidBody> {
         let slot = self.slots.get_mut(handle.index as usize)?;
-        (slot.generation == handle.generation).then_some(slot.body.as_mut()).flatten()
+        (slot.generation == handle.generation)
+            .then_some(slot.body.as_mut())
+            .flatten()
     }
 
     /// Whether `handle` names a live body.
@@ -117,7 +130,15 @@ impl BodySet {
     /// Live bodies with their handles, in slot order.
     pub fn iter(&self) -> impl Iterator<Item = (BodyHandle, &RigidBody)> {
         self.slots.iter().enumerate().filter_map(|(i, s)| {
-            s.body.as_ref().map(|b| (BodyHandle { index: i as u32, generation: s.generation }, b))
+            s.body.as_ref().map(|b| {
+                (
+                    BodyHandle {
+                        index: i as u32,
+                        generation: s.generation,
+                    },
+                    b,
+                )
+            })
         })
     }
 
@@ -125,14 +146,30 @@ impl BodySet {
     pub fn iter_mut(&mut self) -> impl Iterator<Item = (BodyHandle, &mut RigidBody)> {
         self.slots.iter_mut().enumerate().filter_map(|(i, s)| {
             let generation = s.generation;
-            s.body.as_mut().map(|b| (BodyHandle { index: i as u32, generation }, b))
+            s.body.as_mut().map(|b| {
+                (
+                    BodyHandle {
+                        index: i as u32,
+                        generation,
+                    },
+                    b,
+                )
+            })
         })
     }
 
     /// The live body in slot `index`, with its handle.
     pub fn by_index(&self, index: u32) -> Option<(BodyHandle, &RigidBody)> {
         let s = self.slots.get(index as usize)?;
-        s.body.as_ref().map(|b| (BodyHandle { index, generation: s.generation }, b))
+        s.body.as_ref().map(|b| {
+            (
+                BodyHandle {
+                    index,
+                    generation: s.generation,
+                },
+                b,
+            )
+        })
     }
 }
 

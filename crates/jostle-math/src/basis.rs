@@ -56,10 +56,16 @@ mod tests {
         let (x, y, z) = (b.x_axis, b.y_axis, b.z_axis);
         assert!((x - n).length() < 1e-6, "x column must be the normal");
         for (name, v) in [("x", x), ("y", y), ("z", z)] {
-            assert!((v.length() - 1.0).abs() < 1e-5, "{name} not unit for n = {n}: {v}");
+            assert!(
+                (v.length() - 1.0).abs() < 1e-5,
+                "{name} not unit for n = {n}: {v}"
+            );
         }
         assert!(x.dot(y).abs() < 1e-5 && x.dot(z).abs() < 1e-5 && y.dot(z).abs() < 1e-5);
-        assert!((x.cross(y) - z).length() < 1e-5, "basis must be right-handed for n = {n}");
+        assert!(
+            (x.cross(y) - z).length() < 1e-5,
+            "basis must be right-handed for n = {n}"
+        );
     }
 
     #[test]
@@ -67,7 +73,11 @@ mod tests {
         let eps = [0.0f32, 1e-4, 1e-2, 0.3];
         for axis in [Vec3::X, Vec3::Y, Vec3::Z, -Vec3::X, -Vec3::Y, -Vec3::Z] {
             for &e in &eps {
-                for tilt in [Vec3::new(e, e, 0.0), Vec3::new(0.0, e, -e), Vec3::new(-e, 0.0, e)] {
+                for tilt in [
+                    Vec3::new(e, e, 0.0),
+                    Vec3::new(0.0, e, -e),
+                    Vec3::new(-e, 0.0, e),
+                ] {
                     let n = (axis + tilt).normalize();
                     assert_orthonormal(contact_basis(n), n);
                 }

@@ -46,12 +46,18 @@ impl InertiaShape {
     /// Volume in m³.
     pub fn volume(self) -> f32 {
         match self {
-            Self::Sphere { radius } | Self::HollowSphere { radius } => 4.0 / 3.0 * PI * radius.powi(3),
-            Self::Cuboid { half_extents: h } => 8.0 * h.x * h.y * h.z,
-            Self::Cylinder { half_height, radius } => PI * radius * radius * 2.0 * half_height,
-            Self::Capsule { half_height, radius } => {
-                PI * radius * radius * 2.0 * half_height + 4.0 / 3.0 * PI * radius.powi(3)
+            Self::Sphere { radius } | Self::HollowSphere { radius } => {
+                4.0 / 3.0 * PI * radius.powi(3)
             }
+            Self::Cuboid { half_extents: h } => 8.0 * h.x * h.y * h.z,
+            Self::Cylinder {
+                half_height,
+                radius,
+            } => PI * radius * radius * 2.0 * half_height,
+            Self::Capsule {
+                half_height,
+                radius,
+            } => PI * radius * radius * 2.0 * half_height + 4.0 / 3.0 * PI * radius.powi(3),
         }
     }
 
@@ -64,11 +70,17 @@ impl InertiaShape {
                 let s = h * h;
                 Vec3::new(s.y + s.z, s.x + s.z, s.x + s.y) * (mass / 3.0)
             }
-            Self::Cylinder { half_height: h, radius: r } => {
+            Self::Cylinder {
+                half_height: h,
+                radius: r,
+            } => {
                 let side = mass * (3.0 * r * r + 4.0 * h * h) / 12.0;
                 Vec3::new(side, 0.5 * mass * r * r, side)
             }
-            Self::Capsule { half_height: h, radius: r } => {
+            Self::Capsule {
+                half_height: h,
+                radius: r,
+            } => {
                 // Split the mass by volume between the cylinder and the two caps (one sphere),
                 // then move each hemisphere's inertia to the capsule centre (parallel axes).
                 let v_cyl = PI * r * r * 2.0 * h;
@@ -95,7 +107,13 @@ impl InertiaShape {
 /// The inverse of a diagonal tensor given by its principal moments, with zero where a moment is
 /// zero or not finite (an axis about which the body cannot rotate).
 pub fn inverse_principal(principal: Vec3) -> Vec3 {
-    let inv = |x: f32| if x > 0.0 && x.is_finite() { 1.0 / x } else { 0.0 };
+    let inv = |x: f32| {
+        if x > 0.0 && x.is_finite() {
+            1.0 / x
+        } else {
+            0.0
+        }
+    };
     Vec3::new(inv(principal.x), inv(principal.y), inv(principal.z))
 }
 
@@ -118,24 +136,51 @@ mod tests {
     fn lecture_cube_and_spheres() {
         // The seed's worked examples: a solid cube of side 12 and mass 10 has I = 240;
         // a solid sphere of radius 6 and mass 100 has I = 1440.
-        let cube = InertiaShape::Cuboid { half_extents: Vec3::splat(6.0) };
-        assert!(close(cube.principal_inertia(10.0), Vec3::splat(240.0), 1e-6));
+        let cube = InertiaShape::Cuboid {
+            half_extents: Vec3::splat(6.0),
+        };
+        assert!(close(
+            cube.principal_inertia(10.0),
+            Vec3::splat(240.0),
+            1e-6
+        ));
         let ball = InertiaShape::Sphere { radius: 6.0 };
-        assert!(close(ball.principal_inertia(100.0), Vec3::splat(1440.0), 1e-6));
+        assert!(close(
+            ball.principal_inertia(100.0),
+            Vec3::splat(1440.0),
+            1e-6
+        ));
         let shell = InertiaShape::HollowSphere { radius: 3.0 };
         assert!(close(shell.principal_inertia(3.0), Vec3::splat(18.0), 1e-6));
     }
 
     #[test]
     fn cylinder_and_capsule_closed_forms() {
-        let cyl = InertiaShape::Cylinder { half_height: 1.0, radius: 0.5 };
+        let cyl = InertiaShape::Cylinder {
+            half_height: 1.0,
+            radius: 0.5,
+        };
         let i = cyl.principal_inertia(2.0);
-        assert!(close(i, Vec3::new(2.0 * (0.75 + 4.0) / 12.0, 0.25, 2.0 * (0.75 + 4.0) / 12.0), 1e-6));
+        assert!(close(
+            i,
+            Vec3::new(2.0 * (0.75 + 4.0) / 12.0, 0.25, 2.0 * (0.75 + 4.0) / 12.0),
+            1e-6
+        ));
         // A capsule with no cylinder is a sphere.
-        let cap = InertiaShape::Capsule { half_height: 0.0, radius: 2.0 };
-        assert!(close(cap.principal_inertia(5.0), Vec3::splat(0.4 * 5.0 * 4.0), 1e-5));
+        let cap = InertiaShape::Capsule {
+            half_height: 0.0,
+            radius: 2.0,
+        };
+        assert!(close(
+            cap.principal_inertia(5.0),
+            Vec3::splat(0.4 * 5.0 * 4.0),
+            1e-5
+        ));
         // A capsule with vanishing radius is a thin rod: I = m·L²/12 transverse.
-        let rod = InertiaShape::Capsule { half_height: 1.0, radius: 1e-4 };
+        let rod = InertiaShape::Capsule {
+            half_height: 1.0,
+            radius: 1e-4,
+        };
         let i = rod.principal_inertia(3.0);
         assert!((i.x - 3.0 * 4.0 / 12.0).abs() < 1e-3 && i.y < 1e-6);
     }
@@ -153,6 +198,9 @@ mod tests {
 
     #[test]
     fn inverse_principal_handles_infinite_and_zero() {
-        assert_eq!(inverse_principal(Vec3::new(2.0, 0.0, f32::INFINITY)), Vec3::new(0.5, 0.0, 0.0));
+        assert_eq!(
+            inverse_principal(Vec3::new(2.0, 0.0, f32::INFINITY)),
+            Vec3::new(0.5, 0.0, 0.0)
+        );
     }
 }

@@ -42,7 +42,10 @@ mod tests {
             q = integrate_orientation(q, omega * dt);
         }
         let exact = Quat::from_scaled_axis(omega);
-        assert!(q.abs_diff_eq(exact, 1e-3) || q.abs_diff_eq(-exact, 1e-3), "{q:?} vs {exact:?}");
+        assert!(
+            q.abs_diff_eq(exact, 1e-3) || q.abs_diff_eq(-exact, 1e-3),
+            "{q:?} vs {exact:?}"
+        );
         assert!((q.length() - 1.0).abs() < 1e-5);
     }
 

@@ -1,0 +1,236 @@
+//! Islands: bodies joined by touching contacts, never through fixed bodies.
+//!
+//! Found afresh each step with a union-find over the awake bodies' slot indices, so island
+//! ids are deterministic (an island's id is the smallest slot index in it). Sleeping islands
+//! are remembered as member lists so that waking one body wakes all of them.
+
+use crate::{SleepSettings, motion};
+use jostle_body::{BodyHandle, BodySet};
+
+/// Union-find over dense indices with path halving and union by smaller root (deterministic:
+/// the root of a set is always its smallest index).
+#[derive(Clone, Debug, Default)]
+pub struct UnionFind {
+    parent: Vec<u32>,
+}
+
+impl UnionFind {
+    /// `n` singleton sets.
+    pub fn new(n: usize) -> Self {
+        Self {
+            parent: (0..n as u32).collect(),
+        }
+    }
+
+    /// The root (smallest index) of `i`'s set.
+    pub fn find(&mut self, mut i: u32) -> u32 {
+        while self.parent[i as usize] != i {
+            let p = self.parent[i as usize];
+            self.parent[i as usize] = self.parent[p as usize];
+            i = p;
+        }
+        i
+    }
+
+    /// Joins the sets of `a` and `b`.
+    pub fn union(&mut self, a: u32, b: u32) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+            self.parent[hi as usize] = lo;
+        }
+    }
+}
+
+/// Islands of the current step and the sleeping islands of earlier steps.
+#[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct IslandSet {
+    /// For each body slot: the sleeping island it belongs to (index into `sleeping`), if any.
+    sleeping_of: Vec<Option<u32>>,
+    /// Member lists of sleeping islands; `None` once woken (ids are reused after compaction).
+    sleeping: Vec<Option<Vec<BodyHandle>>>,
+    /// Number of awake islands found by the last [`IslandSet::update`].
+    awake_islands: usize,
+}
+
+impl IslandSet {
+    /// An empty set.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Islands of awake bodies found by the last update.
+    pub fn awake_islands(&self) -> usize {
+        self.awake_islands
+    }
+
+    /// Sleeping islands currently remembered.
+    pub fn sleeping_islands(&self) -> usize {
+        self.sleeping.iter().filter(|s| s.is_some()).count()
+    }
+
+    /// Wakes `handle` and, if it sleeps in an island, every body of that island. Returns
+    /// whether anything woke.
+    pub fn wake(
+        &mut self,
+        bodies: &mut BodySet,
+        handle: BodyHandle,
+        settings: &SleepSettings,
+    ) -> bool {
+        let Some(body) = bodies.get_mut(handle) else {
+            return false;
+        };
+        if body.is_fixed() || body.sleep.awake {
+            return false;
+        }
+        let island = self
+            .sleeping_of
+            .get(handle.index() as usize)
+            .copied()
+            .flatten();
+        match island.and_then(|i| self.sleeping[i as usize].take()) {
+            Some(members) => {
+                for m in members {
+                    if let Some(b) = bodies.get_mut(m) {
+                        motion::wake(b, settings);
+                    }
+                    self.sleeping_of[m.index() as usize] = None;
+                }
+            }
+            None => motion::wake(body, settings),
+        }
+        true
+    }
+
+    /// Forgets everything about sleeping islands except per-body membership of sleeping bodies
+    /// (for a body removed from the world).
+    pub fn forget(&mut self, handle: BodyHandle) {
+        if let Some(slot) = self.sleeping_of.get_mut(handle.index() as usize)
+            && let Some(i) = slot.take()
+            && let Some(members) = self.sleeping[i as usize].as_mut()
+        {
+            members.retain(|&m| m != handle);
+        }
+    }
+
+    /// After a step: finds the islands of awake bodies joined by `touching` pairs (pairs that
+    /// involve a fixed body are ignored: islands never join through static geometry), and puts
+    /// to sleep every island whose bodies all `qualifies` (a slot-indexed table, typically from
+    /// [`crate::update_motion`]). Returns the number of bodies put to sleep.
+    pub fn update(
+        &mut self,
+        bodies: &mut BodySet,
+        touching: impl IntoIterator<Item = (BodyHandle, BodyHandle)>,
+        qualifies: &[bool],
+    ) -> usize {
+        let n = bodies.capacity_index();
+        self.sleeping_of.resize(n, None);
+        let mut uf = UnionFind::new(n);
+        for (a, b) in touching {
+            let awake = |h: BodyHandle| bodies.get(h).is_some_and(|b| b.is_awake());
+            if awake(a) && awake(b) {
+                uf.union(a.index(), b.index());
+            }
+        }
+        // all_qualify[root] = every member qualifies.
+        let mut all_qualify = vec![true; n];
+        let mut is_root = vec![false; n];
+        let awake: Vec<(BodyHandle, u32)> = bodies
+            .iter()
+            .filter(|(_, b)| b.is_awake())
+            .map(|(h, _)| (h, uf.find(h.index())))
+            .collect();
+        for &(h, root) in &awake {
+            is_root[root as usize] = true;
+            if !qualifies.get(h.index() as usize).copied().unwrap_or(false) {
+                all_qualify[root as usize] = false;
+            }
+        }
+        self.awake_islands = is_root.iter().filter(|&&r| r).count();
+        // Group sleeping islands in slot order (deterministic).
+        let mut new_islands: Vec<(u32, Vec<BodyHandle>)> = Vec::new();
+        let mut island_of_root: Vec<Option<usize>> = vec![None; n];
+        for &(h, root) in &awake {
+            if all_qualify[root as usize] {
+                let idx = *island_of_root[root as usize].get_or_insert_with(|| {
+                    new_islands.push((root, Vec::new()));
+                    new_islands.len() - 1
+                });
+                new_islands[idx].1.push(h);
+            }
+        }
+        let mut slept = 0;
+        for (_, members) in new_islands {
+            let id = match self.sleeping.iter().position(|s| s.is_none()) {
+                Some(free) => free,
+                None => {
+                    self.sleeping.push(None);
+                    self.sleeping.len() - 1
+                }
+            };
+            for &m in &members {
+                if let Some(b) = bodies.get_mut(m) {
+                    motion::sleep(b);
+                }
+                self.sleeping_of[m.index() as usize] = Some(id as u32);
+            }
+            slept += members.len();
+            self.sleeping[id] = Some(members);
+        }
+        slept
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use jostle_body::RigidBody;
+    use jostle_math::Mat3;
+
+    fn dynamic() -> RigidBody {
+        RigidBody::dynamic(1.0, Mat3::IDENTITY).unwrap()
+    }
+
+    #[test]
+    fn union_find_roots_are_smallest_indices() {
+        let mut uf = UnionFind::new(6);
+        uf.union(5, 3);
+        uf.union(3, 4);
+        uf.union(1, 2);
+        assert_eq!(uf.find(5), 3);
+        assert_eq!(uf.find(4), 3);
+        assert_eq!(uf.find(2), 1);
+        assert_eq!(uf.find(0), 0);
+    }
+
+    #[test]
+    fn islands_sleep_as_a_unit_and_never_join_through_fixed_bodies() {
+        let mut bodies = BodySet::new();
+        let ground = bodies.insert(RigidBody::fixed());
+        let a = bodies.insert(dynamic());
+        let b = bodies.insert(dynamic());
+        let c = bodies.insert(dynamic());
+        let mut islands = IslandSet::new();
+        // a–b touch; both touch the ground; c touches only the ground. a and c qualify, b not.
+        let touching = [(a, b), (a, ground), (b, ground), (c, ground)];
+        let mut q = vec![false; bodies.capacity_index()];
+        q[a.index() as usize] = true;
+        q[c.index() as usize] = true;
+        let slept = islands.update(&mut bodies, touching, &q);
+        assert_eq!(slept, 1, "only c's island sleeps");
+        assert_eq!(islands.awake_islands(), 2);
+        assert!(!bodies.get(c).unwrap().sleep.awake);
+        assert!(bodies.get(a).unwrap().sleep.awake && bodies.get(b).unwrap().sleep.awake);
+
+        q[b.index() as usize] = true;
+        assert_eq!(islands.update(&mut bodies, touching, &q), 2);
+        // Waking a wakes b (same island) but not c.
+        let s = SleepSettings::default();
+        assert!(islands.wake(&mut bodies, a, &s));
+        assert!(bodies.get(b).unwrap().sleep.awake);
+        assert!(!bodies.get(c).unwrap().sleep.awake);
+        assert_eq!(bodies.get(b).unwrap().sleep.motion, 2.0 * s.threshold);
+        assert_eq!(islands.sleeping_islands(), 1);
+    }
+}

@@ -1,0 +1,32 @@
+//! Sleep settings.
+
+/// How bodies go to sleep. Plain settings; every field's unit and default is documented.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
+pub struct SleepSettings {
+    /// Whether islands may sleep at all. Default true. Disabling it is for benchmarks and
+    /// debugging: every body is then simulated every step.
+    pub enabled: bool,
+    /// Sleep threshold ε on the motion average |v|² + |ω|² (m²/s², rad²/s² counted alike).
+    /// Default 0.3, the value of Millington's Cyclone. A body qualifies for sleep when its
+    /// motion is below ε; its motion is capped at 10·ε and set to 2·ε when it wakes.
+    pub threshold: f32,
+    /// Base of the recency bias: per step, bias = `bias_base`^dt, and
+    /// motion ← bias·motion + (1 − bias)·(|v|² + |ω|²). Default 0.5 (motion halves its weight
+    /// every second of simulated time), as in Cyclone.
+    pub bias_base: f32,
+}
+
+impl Default for SleepSettings {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            threshold: 0.3,
+            bias_base: 0.5,
+        }
+    }
+}
