@@ -1,1 +1,38 @@
-fn main() {}
+//! The `jostle` command: runs a scene headless with a progress bar, prints a summary table or
+//! one JSON object, and can write a per-step CSV trace.
+//!
+//! It is a thin shell over the facade: scene loading, the run loop and the trace format live
+//! in `jostle` itself (`jostle::scene`, `jostle::run`), so tests and benches use the same code.
+
+mod run_cmd;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// jostle: a 3D rigid-body contact physics engine.
+#[derive(Parser, Debug)]
+#[command(name = "jostle", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Run a scene headless and print a summary.
+    Run(run_cmd::RunArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run(args) => run_cmd::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,56 @@
+//! The per-step profile: the time of every pipeline stage and the counters that explain it.
+
+use std::time::Duration;
+
+/// What the last [`crate::World::step`] did and how long each stage took. Built fresh by every
+/// step; read it with [`crate::World::profile`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StepProfile {
+    /// Whole step.
+    pub total: Duration,
+    /// Broad phase: candidate pairs from AABBs.
+    pub broad_phase: Duration,
+    /// Narrow phase: persistent contact manifolds.
+    pub narrow_phase: Duration,
+    /// Islands and wake-up.
+    pub islands: Duration,
+    /// Copying awake bodies and contacts into the solver arrays, applying forces.
+    pub gather: Duration,
+    /// The resolver (integration included; see `resolve_stats` for its parts).
+    pub resolve: Duration,
+    /// Copying results back, finiteness checks.
+    pub scatter: Duration,
+    /// Sleep update.
+    pub sleep: Duration,
+    /// The resolver's own breakdown.
+    pub resolve_stats: jostle_resolve::ResolveStats,
+    /// Candidate pairs from the broad phase.
+    pub candidate_pairs: usize,
+    /// Contact manifolds with at least one point.
+    pub manifolds: usize,
+    /// Contact points handed to the resolver.
+    pub contact_points: usize,
+    /// Manifolds reused because their pair's relative pose did not change.
+    pub manifolds_reused: usize,
+    /// Awake dynamic bodies at the end of the step.
+    pub awake_bodies: usize,
+    /// Sleeping dynamic bodies at the end of the step.
+    pub sleeping_bodies: usize,
+    /// Islands of touching awake bodies this step.
+    pub islands_count: usize,
+}
+
+impl StepProfile {
+    /// The stages in pipeline order with their times, for tables.
+    pub fn stages(&self) -> [(&'static str, Duration); 7] {
+        [
+            ("broad", self.broad_phase),
+            ("narrow", self.narrow_phase),
+            ("islands", self.islands),
+            ("gather", self.gather),
+            ("resolve", self.resolve),
+            ("scatter", self.scatter),
+            ("sleep", self.sleep),
+        ]
+    }
+}

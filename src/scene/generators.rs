@@ -1,0 +1,429 @@
+//! Scene generators: large layouts from a few parameters, so benchmark scenes stay small files.
+
+use crate::body_desc::{BodyDesc, MassSpec};
+use jostle_collide::{Material, ShapeDesc};
+use jostle_math::Vec3;
+use serde::{Deserialize, Serialize};
+
+fn half() -> f32 {
+    0.5
+}
+fn friction() -> f32 {
+    0.6
+}
+fn density() -> f32 {
+    1000.0
+}
+
+/// A generator of bodies (`generators: [Pyramid(rows: 20), ...]`). All boxes are cuboids named
+/// `<name>-<i>` in generation order, resting exactly on y = `origin.y` (no initial overlap).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Generator {
+    /// A 2D pyramid in the XY plane: `rows` boxes at the bottom, one fewer in each row above
+    /// (rows·(rows+1)/2 boxes).
+    Pyramid {
+        /// Rows (bottom row has this many boxes).
+        rows: u32,
+        /// Half the box size (m). Default 0.5 (1 m boxes).
+        #[serde(default = "half")]
+        half_extent: f32,
+        /// Horizontal gap between neighbouring boxes (m). Default 0.
+        #[serde(default)]
+        gap: f32,
+        /// Centre of the bottom row's base (m).
+        #[serde(default)]
+        origin: Vec3,
+        /// Friction. Default 0.6.
+        #[serde(default = "friction")]
+        friction: f32,
+        /// Density (kg/m³). Default 1000.
+        #[serde(default = "density")]
+        density: f32,
+        /// Density of the top box (kg/m³), for mass-ratio scenes. Default: `density`.
+        #[serde(default)]
+        top_density: Option<f32>,
+        /// Name prefix. Default "pyramid".
+        #[serde(default)]
+        name: Option<String>,
+    },
+    /// A 3D pyramid of square layers: `layers`² boxes at the bottom, (layers−1)² above, …
+    /// (layers·(layers+1)·(2·layers+1)/6 boxes: 385 for 10 layers).
+    Pyramid3D {
+        /// Layers.
+        layers: u32,
+        /// Half the box size (m). Default 0.5.
+        #[serde(default = "half")]
+        half_extent: f32,
+        /// Centre of the bottom layer's base (m).
+        #[serde(default)]
+        origin: Vec3,
+        /// Friction. Default 0.6.
+        #[serde(default = "friction")]
+        friction: f32,
+        /// Density (kg/m³). Default 1000.
+        #[serde(default = "density")]
+        density: f32,
+        /// Name prefix. Default "pyramid3d".
+        #[serde(default)]
+        name: Option<String>,
+    },
+    /// A vertical stack of `count` boxes.
+    Stack {
+        /// Boxes.
+        count: u32,
+        /// Half extents of each box (m). Default (0.5, 0.5, 0.5).
+        #[serde(default = "half_extents")]
+        half_extents: Vec3,
+        /// Centre of the bottom box's base (m).
+        #[serde(default)]
+        origin: Vec3,
+        /// Friction. Default 0.6.
+        #[serde(default = "friction")]
+        friction: f32,
+        /// Density (kg/m³). Default 1000.
+        #[serde(default = "density")]
+        density: f32,
+        /// Name prefix. Default "stack".
+        #[serde(default)]
+        name: Option<String>,
+    },
+    /// A brick wall in the XY plane, `columns` bricks long and `rows` high, every other row
+    /// offset by half a brick.
+    Wall {
+        /// Bricks per row.
+        columns: u32,
+        /// Rows.
+        rows: u32,
+        /// Half extents of a brick (m). Default (0.5, 0.25, 0.25).
+        #[serde(default = "brick")]
+        half_extents: Vec3,
+        /// Centre of the bottom row's base (m).
+        #[serde(default)]
+        origin: Vec3,
+        /// Friction. Default 0.6.
+        #[serde(default = "friction")]
+        friction: f32,
+        /// Density (kg/m³). Default 1000.
+        #[serde(default = "density")]
+        density: f32,
+        /// Name prefix. Default "wall".
+        #[serde(default)]
+        name: Option<String>,
+    },
+    /// A grid of separate piles: `nx`·`nz` stacks of `height` boxes, `spacing` apart.
+    Piles {
+        /// Piles along X.
+        nx: u32,
+        /// Piles along Z.
+        nz: u32,
+        /// Boxes per pile.
+        height: u32,
+        /// Distance between pile centres (m). Default 3.
+        #[serde(default = "spacing")]
+        spacing: f32,
+        /// Half the box size (m). Default 0.5.
+        #[serde(default = "half")]
+        half_extent: f32,
+        /// Centre of the grid's base (m).
+        #[serde(default)]
+        origin: Vec3,
+        /// Friction. Default 0.6.
+        #[serde(default = "friction")]
+        friction: f32,
+        /// Density (kg/m³). Default 1000.
+        #[serde(default = "density")]
+        density: f32,
+        /// Name prefix. Default "pile".
+        #[serde(default)]
+        name: Option<String>,
+    },
+}
+
+fn half_extents() -> Vec3 {
+    Vec3::splat(0.5)
+}
+fn brick() -> Vec3 {
+    Vec3::new(0.5, 0.25, 0.25)
+}
+fn spacing() -> f32 {
+    3.0
+}
+
+fn cuboid(name: String, h: Vec3, centre: Vec3, friction: f32, density: f32) -> BodyDesc {
+    let mut d = BodyDesc::dynamic(name, ShapeDesc::Cuboid { half_extents: h }).at(centre);
+    d.mass = MassSpec::Density(density);
+    d.material = Material {
+        friction,
+        restitution: 0.0,
+    };
+    d
+}
+
+impl Generator {
+    /// Checks the parameters; the error is (field, message).
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        let positive = |field: &str, x: f32| {
+            if x.is_finite() && x > 0.0 {
+                Ok(())
+            } else {
+                Err((
+                    field.to_string(),
+                    format!("must be finite and > 0, got {x}"),
+                ))
+            }
+        };
+        let count = |field: &str, n: u32| {
+            if (1..=100_000).contains(&n) {
+                Ok(())
+            } else {
+                Err((field.to_string(), format!("must be in 1..=100000, got {n}")))
+            }
+        };
+        let common = |origin: &Vec3, friction: f32, density: f32| {
+            if !origin.is_finite() {
+                return Err((
+                    "origin".to_string(),
+                    format!("must be finite, got {origin}"),
+                ));
+            }
+            if !(friction.is_finite() && friction >= 0.0) {
+                return Err((
+                    "friction".to_string(),
+                    format!("must be finite and >= 0, got {friction}"),
+                ));
+            }
+            positive("density", density)
+        };
+        match self {
+            Self::Pyramid {
+                rows,
+                half_extent,
+                gap,
+                origin,
+                friction,
+                density,
+                top_density,
+                ..
+            } => {
+                count("rows", *rows)?;
+                positive("half_extent", *half_extent)?;
+                if !(gap.is_finite() && *gap >= 0.0) {
+                    return Err(("gap".into(), format!("must be finite and >= 0, got {gap}")));
+                }
+                if let Some(t) = top_density {
+                    positive("top_density", *t)?;
+                }
+                common(origin, *friction, *density)
+            }
+            Self::Pyramid3D {
+                layers,
+                half_extent,
+                origin,
+                friction,
+                density,
+                ..
+            } => {
+                count("layers", *layers)?;
+                positive("half_extent", *half_extent)?;
+                common(origin, *friction, *density)
+            }
+            Self::Stack {
+                count: n,
+                half_extents,
+                origin,
+                friction,
+                density,
+                ..
+            } => {
+                count("count", *n)?;
+                if !(half_extents.is_finite() && half_extents.min_element() > 0.0) {
+                    return Err((
+                        "half_extents".into(),
+                        format!("must be finite and > 0, got {half_extents}"),
+                    ));
+                }
+                common(origin, *friction, *density)
+            }
+            Self::Wall {
+                columns,
+                rows,
+                half_extents,
+                origin,
+                friction,
+                density,
+                ..
+            } => {
+                count("columns", *columns)?;
+                count("rows", *rows)?;
+                if !(half_extents.is_finite() && half_extents.min_element() > 0.0) {
+                    return Err((
+                        "half_extents".into(),
+                        format!("must be finite and > 0, got {half_extents}"),
+                    ));
+                }
+                common(origin, *friction, *density)
+            }
+            Self::Piles {
+                nx,
+                nz,
+                height,
+                spacing,
+                half_extent,
+                origin,
+                friction,
+                density,
+                ..
+            } => {
+                count("nx", *nx)?;
+                count("nz", *nz)?;
+                count("height", *height)?;
+                positive("spacing", *spacing)?;
+                positive("half_extent", *half_extent)?;
+                common(origin, *friction, *density)
+            }
+        }
+    }
+
+    /// The bodies this generator makes, in a fixed order (bottom to top, −X to +X, −Z to +Z).
+    pub fn bodies(&self) -> Vec<BodyDesc> {
+        let mut out = Vec::new();
+        match self {
+            Self::Pyramid {
+                rows,
+                half_extent: h,
+                gap,
+                origin,
+                friction,
+                density,
+                top_density,
+                name,
+            } => {
+                let name = name.as_deref().unwrap_or("pyramid");
+                let pitch = 2.0 * h + gap;
+                for row in 0..*rows {
+                    let n = rows - row;
+                    for i in 0..n {
+                        let x = (i as f32 - (n - 1) as f32 / 2.0) * pitch;
+                        let y = h + 2.0 * h * row as f32;
+                        let d = if n == 1 {
+                            top_density.unwrap_or(*density)
+                        } else {
+                            *density
+                        };
+                        let centre = *origin + Vec3::new(x, y, 0.0);
+                        out.push(cuboid(
+                            format!("{name}-{}", out.len()),
+                            Vec3::splat(*h),
+                            centre,
+                            *friction,
+                            d,
+                        ));
+                    }
+                }
+            }
+            Self::Pyramid3D {
+                layers,
+                half_extent: h,
+                origin,
+                friction,
+                density,
+                name,
+            } => {
+                let name = name.as_deref().unwrap_or("pyramid3d");
+                for layer in 0..*layers {
+                    let n = layers - layer;
+                    for i in 0..n {
+                        for k in 0..n {
+                            let off = |j: u32| (j as f32 - (n - 1) as f32 / 2.0) * 2.0 * h;
+                            let centre =
+                                *origin + Vec3::new(off(i), h + 2.0 * h * layer as f32, off(k));
+                            out.push(cuboid(
+                                format!("{name}-{}", out.len()),
+                                Vec3::splat(*h),
+                                centre,
+                                *friction,
+                                *density,
+                            ));
+                        }
+                    }
+                }
+            }
+            Self::Stack {
+                count,
+                half_extents: he,
+                origin,
+                friction,
+                density,
+                name,
+            } => {
+                let name = name.as_deref().unwrap_or("stack");
+                for i in 0..*count {
+                    let centre = *origin + Vec3::new(0.0, he.y * (2 * i + 1) as f32, 0.0);
+                    out.push(cuboid(
+                        format!("{name}-{i}"),
+                        *he,
+                        centre,
+                        *friction,
+                        *density,
+                    ));
+                }
+            }
+            Self::Wall {
+                columns,
+                rows,
+                half_extents: he,
+                origin,
+                friction,
+                density,
+                name,
+            } => {
+                let name = name.as_deref().unwrap_or("wall");
+                for row in 0..*rows {
+                    let shift = if row % 2 == 1 { he.x } else { 0.0 };
+                    for c in 0..*columns {
+                        let x = (c as f32 - (*columns - 1) as f32 / 2.0) * 2.0 * he.x + shift;
+                        let centre = *origin + Vec3::new(x, he.y * (2 * row + 1) as f32, 0.0);
+                        out.push(cuboid(
+                            format!("{name}-{}", out.len()),
+                            *he,
+                            centre,
+                            *friction,
+                            *density,
+                        ));
+                    }
+                }
+            }
+            Self::Piles {
+                nx,
+                nz,
+                height,
+                spacing,
+                half_extent: h,
+                origin,
+                friction,
+                density,
+                name,
+            } => {
+                let name = name.as_deref().unwrap_or("pile");
+                for ix in 0..*nx {
+                    for iz in 0..*nz {
+                        let x = (ix as f32 - (*nx - 1) as f32 / 2.0) * spacing;
+                        let z = (iz as f32 - (*nz - 1) as f32 / 2.0) * spacing;
+                        for k in 0..*height {
+                            let centre = *origin + Vec3::new(x, h * (2 * k + 1) as f32, z);
+                            out.push(cuboid(
+                                format!("{name}-{}", out.len()),
+                                Vec3::splat(*h),
+                                centre,
+                                *friction,
+                                *density,
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+}

@@ -1,0 +1,86 @@
+//! World settings: gravity, the resolver and its settings, collision and sleep settings.
+//! Plain structs; every field documents its unit, default and effect.
+
+use jostle_collide::CollideSettings;
+use jostle_math::Vec3;
+use jostle_resolve::{MillingtonResolver, MillingtonSettings, Resolver};
+use jostle_sleep::SleepSettings;
+
+/// Which resolver a world uses, with its settings. In a scene file:
+/// `resolver: Millington(velocity_iterations: 64)`.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
+pub enum ResolverChoice {
+    /// The seed lecture's resolver: worst-first position pass by nonlinear projection, then
+    /// worst-first velocity pass with micro-collisions and 3×3 friction impulses.
+    Millington(#[cfg_attr(feature = "serde", serde(default))] MillingtonSettings),
+}
+
+impl Default for ResolverChoice {
+    /// The best resolver the engine has: today the Millington resolver (the only one).
+    fn default() -> Self {
+        Self::Millington(MillingtonSettings::default())
+    }
+}
+
+impl ResolverChoice {
+    /// The resolver names accepted on the command line, in order.
+    pub const NAMES: [&'static str; 2] = ["millington", "soft-step"];
+
+    /// The choice for a command-line resolver name with default settings, or an error message
+    /// naming the accepted names.
+    pub fn from_name(name: &str) -> Result<Self, String> {
+        match name {
+            "millington" => Ok(Self::Millington(MillingtonSettings::default())),
+            "soft-step" => {
+                Err("the soft-step resolver is not part of this build yet; use `millington`".into())
+            }
+            other => Err(format!(
+                "unknown resolver `{other}`; expected one of: {}",
+                Self::NAMES.join(", ")
+            )),
+        }
+    }
+
+    /// The command-line name of this choice.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Millington(_) => "millington",
+        }
+    }
+
+    /// Builds the resolver.
+    pub fn build(&self) -> Box<dyn Resolver> {
+        match self {
+            Self::Millington(s) => Box::new(MillingtonResolver::new(s.clone())),
+        }
+    }
+}
+
+/// Everything a [`crate::World`] is configured with.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldSettings {
+    /// Gravity (m/s²). Default (0, −9.81, 0).
+    pub gravity: Vec3,
+    /// The resolver. Default: [`ResolverChoice::default`].
+    pub resolver: ResolverChoice,
+    /// Collision detection: prediction margin and manifold reuse tolerances.
+    pub collide: CollideSettings,
+    /// Sleep: threshold, bias, and whether sleeping is enabled at all.
+    pub sleep: SleepSettings,
+}
+
+impl Default for WorldSettings {
+    fn default() -> Self {
+        Self {
+            gravity: Vec3::new(0.0, -9.81, 0.0),
+            resolver: ResolverChoice::default(),
+            collide: CollideSettings::default(),
+            sleep: SleepSettings::default(),
+        }
+    }
+}

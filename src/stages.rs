@@ -1,0 +1,195 @@
+//! The step's stages that belong to the facade: wake-up, gather, scatter and sleep. Each is a
+//! small function over exactly the data it touches; `World::step` strings them together.
+
+use crate::StepReport;
+use crate::profile::StepProfile;
+use jostle_body::{BodySet, apply_forces};
+use jostle_collide::{BodyContact, NarrowPhase};
+use jostle_resolve::{Contact, STATIC_BODY, SolverBody};
+use jostle_sleep::{IslandSet, SleepSettings, update_motion};
+
+/// Marks a body slot that has no solver entry (sleeping, or not a body).
+const NO_SOLVER: u32 = u32::MAX;
+
+/// Per-step working arrays, kept between steps only to reuse their allocations.
+#[derive(Default)]
+pub(crate) struct Scratch {
+    /// Dense solver bodies; index 0 is the static entry.
+    pub bodies: Vec<SolverBody>,
+    /// Solver contacts.
+    pub contacts: Vec<Contact>,
+    /// For each solver contact, its index in the narrow phase's contact list.
+    pub contact_source: Vec<u32>,
+    /// For each body slot, its solver index or `NO_SOLVER`.
+    pub solver_index: Vec<u32>,
+    /// For each solver body (index ≥ 1), its body slot.
+    pub body_slot: Vec<u32>,
+}
+
+/// Wakes every sleeping island touched by an awake body. Contacts with fixed bodies never
+/// wake anything. Returns whether anything woke.
+pub(crate) fn wake_touching(
+    bodies: &mut BodySet,
+    islands: &mut IslandSet,
+    contacts: &[BodyContact],
+    settings: &SleepSettings,
+) -> bool {
+    let mut woke = false;
+    for c in contacts {
+        let (Some(a), Some(b)) = (bodies.get(c.a), bodies.get(c.b)) else {
+            continue;
+        };
+        if a.is_fixed() || b.is_fixed() || a.sleep.awake == b.sleep.awake {
+            continue;
+        }
+        let sleeper = if a.sleep.awake { c.b } else { c.a };
+        woke |= islands.wake(bodies, sleeper, settings);
+    }
+    woke
+}
+
+/// Copies the awake bodies into the dense solver array (after applying their forces and
+/// damping) and the contacts between solver bodies into solver contacts. Bodies whose state is
+/// not finite are frozen here, before they can spread NaN to their neighbours.
+pub(crate) fn gather(
+    bodies: &mut BodySet,
+    contacts: &[BodyContact],
+    dt: f32,
+    scratch: &mut Scratch,
+    report: &mut StepReport,
+    names: &[String],
+) {
+    scratch.bodies.clear();
+    scratch.bodies.push(SolverBody::STATIC);
+    scratch.body_slot.clear();
+    scratch.body_slot.push(NO_SOLVER);
+    scratch.solver_index.clear();
+    scratch
+        .solver_index
+        .resize(bodies.capacity_index(), NO_SOLVER);
+    for (handle, body) in bodies.iter_mut() {
+        if !body.is_awake() {
+            continue;
+        }
+        apply_forces(body, dt);
+        if !body.is_finite() {
+            body.freeze();
+            report
+                .quarantined
+                .push((handle, names[handle.index() as usize].clone()));
+            continue;
+        }
+        scratch.solver_index[handle.index() as usize] = scratch.bodies.len() as u32;
+        scratch.body_slot.push(handle.index());
+        let mut sb = SolverBody::new(
+            body.position,
+            body.orientation,
+            body.inv_mass(),
+            body.inv_inertia_world(),
+        );
+        sb.linear_velocity = body.linear_velocity;
+        sb.angular_velocity = body.angular_velocity;
+        sb.last_acceleration = body.last_acceleration;
+        scratch.bodies.push(sb);
+    }
+    scratch.contacts.clear();
+    scratch.contact_source.clear();
+    let index_of = |h: jostle_body::BodyHandle| -> Option<u32> {
+        let body = bodies.get(h)?;
+        if body.is_fixed() {
+            Some(STATIC_BODY)
+        } else {
+            let i = scratch.solver_index[h.index() as usize];
+            (i != NO_SOLVER).then_some(i)
+        }
+    };
+    for (i, c) in contacts.iter().enumerate() {
+        let (Some(a), Some(b)) = (index_of(c.a), index_of(c.b)) else {
+            continue;
+        };
+        if a == STATIC_BODY && b == STATIC_BODY {
+            continue;
+        }
+        let mut contact = Contact::new(a, b, c.point, c.normal, c.penetration)
+            .with_friction(c.friction)
+            .with_restitution(c.restitution);
+        contact.impulse = c.impulse;
+        scratch.contacts.push(contact);
+        scratch.contact_source.push(i as u32);
+    }
+}
+
+/// Copies poses and velocities back into the bodies, the contacts' impulses back into the
+/// narrow phase, and quarantines bodies whose new state is not finite.
+pub(crate) fn scatter(
+    bodies: &mut BodySet,
+    narrow: &mut NarrowPhase,
+    scratch: &Scratch,
+    report: &mut StepReport,
+    names: &[String],
+) {
+    for (solver, &slot) in scratch.bodies.iter().zip(&scratch.body_slot).skip(1) {
+        let Some((handle, _)) = bodies.by_index(slot) else {
+            continue;
+        };
+        let Some(body) = bodies.get_mut(handle) else {
+            continue;
+        };
+        let finite = solver.position.is_finite()
+            && solver.orientation.is_finite()
+            && solver.linear_velocity.is_finite()
+            && solver.angular_velocity.is_finite();
+        if !finite {
+            body.freeze();
+            report
+                .quarantined
+                .push((handle, names[slot as usize].clone()));
+            continue;
+        }
+        body.position = solver.position;
+        body.orientation = solver.orientation;
+        body.linear_velocity = solver.linear_velocity;
+        body.angular_velocity = solver.angular_velocity;
+        body.last_acceleration = solver.last_acceleration;
+        body.update_world_inertia();
+    }
+    for (_, body) in bodies.iter_mut() {
+        body.clear_forces();
+    }
+    let mut impulses: Vec<_> = narrow.contacts().iter().map(|c| c.impulse).collect();
+    for (contact, &source) in scratch.contacts.iter().zip(&scratch.contact_source) {
+        impulses[source as usize] = contact.impulse;
+    }
+    narrow.store_impulses(&impulses);
+}
+
+/// Updates motion averages, finds islands and puts resting islands to sleep; fills the
+/// profile's body and island counters.
+pub(crate) fn sleep(
+    bodies: &mut BodySet,
+    islands: &mut IslandSet,
+    contacts: &[BodyContact],
+    settings: &SleepSettings,
+    dt: f32,
+    p: &mut StepProfile,
+) {
+    let mut qualifies = vec![false; bodies.capacity_index()];
+    if settings.enabled {
+        for (h, body) in bodies.iter_mut() {
+            if body.is_awake() {
+                qualifies[h.index() as usize] = update_motion(body, settings, dt);
+            }
+        }
+    }
+    islands.update(bodies, contacts.iter().map(|c| (c.a, c.b)), &qualifies);
+    p.islands_count = islands.awake_islands();
+    for (_, body) in bodies.iter() {
+        if !body.is_fixed() {
+            if body.sleep.awake {
+                p.awake_bodies += 1;
+            } else {
+                p.sleeping_bodies += 1;
+            }
+        }
+    }
+}

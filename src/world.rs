@@ -1,0 +1,451 @@
+//! `World`: bodies, colliders, the resolver and the step pipeline.
+//!
+//! Start reading at [`World::step`]: one linear pipeline of named, timed stages (DESIGN.md,
+//! "The step pipeline"); each stage is a small function in `stages.rs` over exactly the data it
+//! touches.
+
+use crate::body_desc::{BodyDesc, BodyError, MassSpec, shape_error};
+use crate::profile::StepProfile;
+use crate::settings::WorldSettings;
+use crate::stages::{self, Scratch};
+use jostle_body::{BodyHandle, BodySet, RigidBody};
+use jostle_collide::{
+    BodyContact, BroadPhase, Collider, ColliderSet, CollisionEvent, NarrowPhase, RayHit,
+    mass_properties,
+};
+use jostle_math::{Quat, Vec3};
+use jostle_resolve::{Resolver, StepContext};
+use jostle_sleep::IslandSet;
+use std::time::Instant;
+use thiserror::Error;
+
+/// Why a step or an API call was refused.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum StepError {
+    /// The time step must be finite and > 0.
+    #[error("time step must be finite and > 0, got {0}")]
+    InvalidDt(f32),
+    /// The handle is stale (its body was removed) or was never issued by this world.
+    #[error("invalid or stale body handle {0}")]
+    InvalidHandle(BodyHandle),
+    /// A value given through the API is not finite.
+    #[error("{what} must be finite, got {value}")]
+    NonFinite {
+        /// What was given (`force`, `impulse`, `position`, ...).
+        what: &'static str,
+        /// The value, formatted.
+        value: String,
+    },
+}
+
+/// What a step reports besides the profile.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StepReport {
+    /// Bodies whose state went non-finite during this step: each is frozen where it last had a
+    /// finite pose (it becomes a fixed body) and named here. The rest of the world steps on.
+    pub quarantined: Vec<(BodyHandle, String)>,
+}
+
+/// A physics world: add bodies, call [`World::step`].
+pub struct World {
+    settings: WorldSettings,
+    bodies: BodySet,
+    colliders: ColliderSet,
+    names: Vec<String>,
+    broad: BroadPhase,
+    narrow: NarrowPhase,
+    islands: IslandSet,
+    resolver: Box<dyn Resolver>,
+    profile: StepProfile,
+    time: f64,
+    steps: u64,
+    scratch: Scratch,
+}
+
+impl World {
+    /// An empty world.
+    pub fn new(settings: WorldSettings) -> Self {
+        let resolver = settings.resolver.build();
+        Self {
+            settings,
+            bodies: BodySet::new(),
+            colliders: ColliderSet::default(),
+            names: Vec::new(),
+            broad: BroadPhase::default(),
+            narrow: NarrowPhase::default(),
+            islands: IslandSet::new(),
+            resolver,
+            profile: StepProfile::default(),
+            time: 0.0,
+            steps: 0,
+            scratch: Scratch::default(),
+        }
+    }
+
+    /// The settings the world was built with.
+    pub fn settings(&self) -> &WorldSettings {
+        &self.settings
+    }
+
+    /// Replaces the resolver (any implementation of [`Resolver`]).
+    pub fn set_resolver(&mut self, resolver: Box<dyn Resolver>) {
+        self.resolver = resolver;
+    }
+
+    /// The resolver's name.
+    pub fn resolver_name(&self) -> &'static str {
+        self.resolver.name()
+    }
+
+    /// Adds a body and its collider. The body's position is its centre of mass: for shapes
+    /// whose centre of mass is not their origin (convex hulls, compounds), it differs from
+    /// `desc.position` by the rotated centre-of-mass offset.
+    pub fn add_body(&mut self, desc: BodyDesc) -> Result<BodyHandle, BodyError> {
+        desc.validate()?;
+        let shape = desc.shape.build().map_err(|e| shape_error(&desc.name, e))?;
+        let rotation = desc.rotation.normalize();
+        let (body, local_pose) = if desc.fixed {
+            (
+                RigidBody::fixed().with_pose(desc.position, rotation),
+                jostle_collide::Pose::IDENTITY,
+            )
+        } else {
+            let density = match desc.mass {
+                MassSpec::Density(d) => d,
+                MassSpec::Mass(_) => 1.0,
+            };
+            let mut props =
+                mass_properties(&desc.shape, density).map_err(|e| shape_error(&desc.name, e))?;
+            if let MassSpec::Mass(m) = desc.mass {
+                props = props.scaled_to_mass(m);
+            }
+            let body =
+                RigidBody::dynamic(props.mass, props.inertia).map_err(|e| BodyError::Field {
+                    body: desc.name.clone(),
+                    field: "shape".into(),
+                    message: format!("mass properties are degenerate: {e}"),
+                })?;
+            let com = desc.position + rotation * props.local_com;
+            let body = body
+                .with_pose(com, rotation)
+                .with_velocity(desc.linear_velocity, desc.angular_velocity);
+            (
+                body,
+                jostle_collide::Pose::from_translation(-props.local_com),
+            )
+        };
+        let mut body = body;
+        body.linear_damping = desc.linear_damping;
+        body.angular_damping = desc.angular_damping;
+        body.sleep.can_sleep = desc.can_sleep;
+        body.sleep.motion = 2.0 * self.settings.sleep.threshold;
+        let handle = self.bodies.insert(body);
+        self.colliders.insert(Collider {
+            shape,
+            local_pose,
+            material: desc.material,
+            body: handle,
+        });
+        let slot = handle.index() as usize;
+        if self.names.len() <= slot {
+            self.names.resize(slot + 1, String::new());
+        }
+        self.names[slot] = desc.name;
+        Ok(handle)
+    }
+
+    /// The body behind `handle`, or `None` if the handle is stale or invalid.
+    pub fn body(&self, handle: BodyHandle) -> Option<&RigidBody> {
+        self.bodies.get(handle)
+    }
+
+    /// The name the body was added with.
+    pub fn body_name(&self, handle: BodyHandle) -> Option<&str> {
+        self.bodies
+            .contains(handle)
+            .then(|| self.names[handle.index() as usize].as_str())
+    }
+
+    /// The first body with this name, in insertion order.
+    pub fn find_body(&self, name: &str) -> Option<BodyHandle> {
+        self.bodies
+            .iter()
+            .find(|(h, _)| self.names[h.index() as usize] == name)
+            .map(|(h, _)| h)
+    }
+
+    /// All bodies with their handles and names, in a deterministic order.
+    pub fn bodies(&self) -> impl Iterator<Item = (BodyHandle, &str, &RigidBody)> {
+        self.bodies
+            .iter()
+            .map(|(h, b)| (h, self.names[h.index() as usize].as_str(), b))
+    }
+
+    /// Number of bodies (fixed ones included).
+    pub fn body_count(&self) -> usize {
+        self.bodies.len()
+    }
+
+    fn body_mut_awake(&mut self, handle: BodyHandle) -> Result<&mut RigidBody, StepError> {
+        if !self.bodies.contains(handle) {
+            return Err(StepError::InvalidHandle(handle));
+        }
+        self.islands
+            .wake(&mut self.bodies, handle, &self.settings.sleep);
+        self.bodies
+            .get_mut(handle)
+            .ok_or(StepError::InvalidHandle(handle))
+    }
+
+    fn finite(what: &'static str, v: Vec3) -> Result<(), StepError> {
+        if v.is_finite() {
+            Ok(())
+        } else {
+            Err(StepError::NonFinite {
+                what,
+                value: v.to_string(),
+            })
+        }
+    }
+
+    /// Adds a force (N) through the centre of mass for the next step; wakes the body's island.
+    pub fn apply_force(&mut self, handle: BodyHandle, force: Vec3) -> Result<(), StepError> {
+        Self::finite("force", force)?;
+        self.body_mut_awake(handle)?.add_force(force);
+        Ok(())
+    }
+
+    /// Adds a force (N) at a world point for the next step; wakes the body's island.
+    pub fn apply_force_at_point(
+        &mut self,
+        handle: BodyHandle,
+        force: Vec3,
+        point: Vec3,
+    ) -> Result<(), StepError> {
+        Self::finite("force", force)?;
+        Self::finite("point", point)?;
+        self.body_mut_awake(handle)?
+            .add_force_at_point(force, point);
+        Ok(())
+    }
+
+    /// Adds a torque (N·m) for the next step; wakes the body's island.
+    pub fn apply_torque(&mut self, handle: BodyHandle, torque: Vec3) -> Result<(), StepError> {
+        Self::finite("torque", torque)?;
+        self.body_mut_awake(handle)?.add_torque(torque);
+        Ok(())
+    }
+
+    /// Applies an impulse (N·s) at a world point now; wakes the body's island.
+    pub fn apply_impulse_at_point(
+        &mut self,
+        handle: BodyHandle,
+        impulse: Vec3,
+        point: Vec3,
+    ) -> Result<(), StepError> {
+        Self::finite("impulse", impulse)?;
+        Self::finite("point", point)?;
+        self.body_mut_awake(handle)?
+            .apply_impulse_at_point(impulse, point);
+        Ok(())
+    }
+
+    /// Sets the pose of the centre of mass; wakes the body's island.
+    pub fn set_pose(
+        &mut self,
+        handle: BodyHandle,
+        position: Vec3,
+        rotation: Quat,
+    ) -> Result<(), StepError> {
+        Self::finite("position", position)?;
+        if !rotation.is_finite() || rotation.length_squared() < 1e-12 {
+            return Err(StepError::NonFinite {
+                what: "rotation",
+                value: format!("{rotation:?}"),
+            });
+        }
+        let body = self.body_mut_awake(handle)?;
+        body.position = position;
+        body.orientation = rotation.normalize();
+        body.update_world_inertia();
+        Ok(())
+    }
+
+    /// Sets the velocities; wakes the body's island.
+    pub fn set_velocity(
+        &mut self,
+        handle: BodyHandle,
+        linear: Vec3,
+        angular: Vec3,
+    ) -> Result<(), StepError> {
+        Self::finite("linear velocity", linear)?;
+        Self::finite("angular velocity", angular)?;
+        let body = self.body_mut_awake(handle)?;
+        body.linear_velocity = linear;
+        body.angular_velocity = angular;
+        Ok(())
+    }
+
+    /// Wakes the body and its sleeping island.
+    pub fn wake(&mut self, handle: BodyHandle) -> Result<(), StepError> {
+        self.body_mut_awake(handle).map(|_| ())
+    }
+
+    /// Puts the body to sleep now (zero velocity); it wakes on contact with an awake body, a
+    /// force, an impulse or a pose set, like any sleeping body.
+    pub fn sleep(&mut self, handle: BodyHandle) -> Result<(), StepError> {
+        let body = self
+            .bodies
+            .get_mut(handle)
+            .ok_or(StepError::InvalidHandle(handle))?;
+        jostle_sleep::motion::sleep(body);
+        Ok(())
+    }
+
+    /// Simulated time (s) and steps taken.
+    pub fn time(&self) -> (f64, u64) {
+        (self.time, self.steps)
+    }
+
+    /// The profile of the last step.
+    pub fn profile(&self) -> &StepProfile {
+        &self.profile
+    }
+
+    /// The contacts of the last step (detected at its start), with the impulses the resolver
+    /// applied.
+    pub fn contacts(&self) -> &[BodyContact] {
+        self.narrow.contacts()
+    }
+
+    /// Pairs of bodies that started or stopped touching in the last step.
+    pub fn events(&self) -> &[CollisionEvent] {
+        self.narrow.events()
+    }
+
+    /// Largest penetration (m) among the last step's contacts, 0 if none overlap.
+    pub fn max_penetration(&self) -> f32 {
+        self.narrow
+            .contacts()
+            .iter()
+            .map(|c| c.penetration)
+            .fold(0.0, f32::max)
+    }
+
+    /// Total kinetic energy of the dynamic bodies (J).
+    pub fn kinetic_energy(&self) -> f64 {
+        self.bodies
+            .iter()
+            .map(|(_, b)| b.kinetic_energy() as f64)
+            .sum()
+    }
+
+    /// The first body hit by a ray from `origin` along `dir` within `max_distance` (m).
+    pub fn ray_cast(&self, origin: Vec3, dir: Vec3, max_distance: f32) -> Option<RayHit> {
+        jostle_collide::ray_cast(&self.colliders, &self.bodies, origin, dir, max_distance)
+    }
+
+    /// Advances the world by `dt` seconds: the pipeline of DESIGN.md, each stage timed into
+    /// [`World::profile`].
+    ///
+    /// 1. broad phase — candidate pairs (never static–static, sleeping–sleeping or
+    ///    sleeping–static);
+    /// 2. narrow phase — persistent manifolds, contacts B→A;
+    /// 3. islands and wake-up — a sleeping island touched by an awake body wakes (and, if any
+    ///    did, detection runs again so its contacts are in this step);
+    /// 4. gather — awake bodies into the dense solver array (forces and damping applied),
+    ///    contacts into solver contacts; bodies with non-finite state are quarantined here;
+    /// 5. resolve — the resolver resolves contacts and integrates;
+    /// 6. scatter — results back to the bodies, impulses back to the manifolds, quarantine;
+    /// 7. sleep — motion averages, islands, resting islands go to sleep.
+    pub fn step(&mut self, dt: f32) -> Result<StepReport, StepError> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(StepError::InvalidDt(dt));
+        }
+        let start = Instant::now();
+        let mut p = StepProfile::default();
+        let mut report = StepReport::default();
+
+        self.detect(&mut p);
+
+        let t = Instant::now();
+        let woke = stages::wake_touching(
+            &mut self.bodies,
+            &mut self.islands,
+            self.narrow.contacts(),
+            &self.settings.sleep,
+        );
+        p.islands += t.elapsed();
+        if woke {
+            self.detect(&mut p);
+        }
+
+        let t = Instant::now();
+        stages::gather(
+            &mut self.bodies,
+            self.narrow.contacts(),
+            dt,
+            &mut self.scratch,
+            &mut report,
+            &self.names,
+        );
+        p.gather = t.elapsed();
+
+        let t = Instant::now();
+        let ctx = StepContext {
+            gravity: self.settings.gravity,
+            dt,
+        };
+        p.resolve_stats =
+            self.resolver
+                .step(&mut self.scratch.bodies, &mut self.scratch.contacts, &ctx);
+        p.resolve = t.elapsed();
+
+        let t = Instant::now();
+        stages::scatter(
+            &mut self.bodies,
+            &mut self.narrow,
+            &self.scratch,
+            &mut report,
+            &self.names,
+        );
+        p.scatter = t.elapsed();
+
+        let t = Instant::now();
+        stages::sleep(
+            &mut self.bodies,
+            &mut self.islands,
+            self.narrow.contacts(),
+            &self.settings.sleep,
+            dt,
+            &mut p,
+        );
+        p.sleep = t.elapsed();
+
+        p.contact_points = self.scratch.contacts.len();
+        p.total = start.elapsed();
+        self.profile = p;
+        self.time += dt as f64;
+        self.steps += 1;
+        Ok(report)
+    }
+
+    /// Broad and narrow phase, accumulated into the profile.
+    fn detect(&mut self, p: &mut StepProfile) {
+        let t = Instant::now();
+        let pairs = self.broad.update(
+            &self.colliders,
+            &self.bodies,
+            self.settings.collide.prediction,
+        );
+        p.broad_phase += t.elapsed();
+        p.candidate_pairs = pairs.len();
+        let t = Instant::now();
+        let stats =
+            self.narrow
+                .update(pairs, &self.colliders, &self.bodies, &self.settings.collide);
+        p.narrow_phase += t.elapsed();
+        p.manifolds = stats.manifolds;
+        p.manifolds_reused = stats.manifolds_reused;
+    }
+}

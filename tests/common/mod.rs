@@ -1,0 +1,64 @@
+//! Shared builders for the physics validation tests: small worlds with closed-form answers.
+#![allow(dead_code)]
+
+use jostle::{BodyDesc, BodyHandle, Quat, ShapeDesc, Vec3, World, WorldSettings};
+
+/// The time steps every analytic test runs at: 60 Hz and a finer 240 Hz.
+pub const STEPS: [f32; 2] = [1.0 / 60.0, 1.0 / 240.0];
+
+pub fn world(gravity: Vec3) -> World {
+    World::new(WorldSettings {
+        gravity,
+        ..Default::default()
+    })
+}
+
+pub fn ground(world: &mut World, friction: f32, restitution: f32) -> BodyHandle {
+    world
+        .add_body(
+            BodyDesc::fixed("ground", ShapeDesc::HalfSpace { normal: Vec3::Y })
+                .with_material(friction, restitution),
+        )
+        .unwrap()
+}
+
+pub fn ball(world: &mut World, name: &str, radius: f32, mass: f32, at: Vec3) -> BodyHandle {
+    world
+        .add_body(
+            BodyDesc::dynamic(name, ShapeDesc::Ball { radius })
+                .with_mass(mass)
+                .at(at),
+        )
+        .unwrap()
+}
+
+pub fn set_material(desc: BodyDesc, friction: f32, restitution: f32) -> BodyDesc {
+    desc.with_material(friction, restitution)
+}
+
+/// Steps `world` for `seconds` at `dt`, calling `f` after each step.
+pub fn run(world: &mut World, dt: f32, seconds: f32, mut f: impl FnMut(&World)) {
+    let n = (seconds / dt).round() as u32;
+    for _ in 0..n {
+        world.step(dt).unwrap();
+        f(world);
+    }
+}
+
+/// A fixed slope through the origin tilted by `theta` about Z (descending toward +X).
+pub fn slope(world: &mut World, theta: f32, friction: f32) -> BodyHandle {
+    let normal = Quat::from_rotation_z(-theta) * Vec3::Y;
+    world
+        .add_body(
+            BodyDesc::fixed("slope", ShapeDesc::HalfSpace { normal }).with_material(friction, 0.0),
+        )
+        .unwrap()
+}
+
+pub fn momentum(world: &World) -> Vec3 {
+    world
+        .bodies()
+        .filter(|(_, _, b)| !b.is_fixed())
+        .map(|(_, _, b)| b.linear_velocity * b.mass())
+        .sum()
+}

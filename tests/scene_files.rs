@@ -1,0 +1,266 @@
+//! Scene files: the documented example loads exactly as written, defaults are the documented
+//! ones, and every kind of bad input gets an error naming file and line/column or body and
+//! field — never a panic.
+
+use jostle::scene::{Scene, SceneError};
+use jostle::{ShapeDesc, Vec3};
+
+const BOX_DROP: &str = include_str!("../assets/box_drop.ron");
+
+#[test]
+fn box_drop_loads_exactly_as_written() {
+    let scene = Scene::parse(BOX_DROP, "box_drop.ron").unwrap();
+    assert_eq!(scene.name, "box drop");
+    assert_eq!(scene.gravity, Vec3::new(0.0, -9.81, 0.0));
+    assert_eq!(scene.dt, 0.016666668);
+    assert_eq!(scene.steps, 300);
+    assert_eq!(scene.bodies.len(), 2);
+    let ground = &scene.bodies[0];
+    assert!(ground.fixed);
+    assert_eq!(ground.friction, 0.9);
+    assert_eq!(ground.shape, ShapeDesc::HalfSpace { normal: Vec3::Y });
+    let b = &scene.bodies[1];
+    assert_eq!(b.name, "box");
+    assert_eq!(b.mass, Some(8.0));
+    assert_eq!(b.restitution, 0.6);
+    assert_eq!(b.position, Vec3::new(0.0, 3.0, 0.0));
+    let world = scene.build().unwrap();
+    let h = world.find_body("box").unwrap();
+    assert_eq!(world.body(h).unwrap().mass(), 8.0);
+}
+
+#[test]
+fn defaults_are_the_documented_ones() {
+    let scene = Scene::parse("Scene(bodies: [Body(shape: Ball(radius: 0.5))])", "t.ron").unwrap();
+    assert_eq!(scene.gravity, Vec3::new(0.0, -9.81, 0.0));
+    assert_eq!(scene.dt, 1.0 / 60.0);
+    assert_eq!(scene.steps, 600);
+    let b = &scene.bodies[0];
+    assert_eq!(
+        (
+            b.friction,
+            b.restitution,
+            b.linear_damping,
+            b.angular_damping
+        ),
+        (0.5, 0.0, 0.0, 0.0)
+    );
+    assert!(b.can_sleep && !b.fixed);
+    assert_eq!(b.position, Vec3::ZERO);
+    let world = scene.build().unwrap();
+    let (_, _, body) = world.bodies().next().unwrap();
+    // Density 1000 kg/m³: a 0.5 m ball weighs 4/3·π·0.125·1000 ≈ 523.6 kg.
+    assert!((body.mass() - 523.598_8).abs() < 0.05, "{}", body.mass());
+}
+
+fn error(text: &str) -> SceneError {
+    match Scene::parse(text, "bad.ron") {
+        Ok(_) => panic!("accepted a bad scene: {text}"),
+        Err(e) => e,
+    }
+}
+
+fn body_field(text: &str) -> (String, String) {
+    match error(text) {
+        SceneError::Body {
+            file,
+            error: jostle::BodyError::Field { body, field, .. },
+        } => {
+            assert_eq!(file, "bad.ron");
+            (body, field)
+        }
+        other => panic!("expected a body error, got {other}"),
+    }
+}
+
+#[test]
+fn malformed_ron_reports_line_and_column() {
+    let e = error(
+        "Scene(\n  name: \"x\",\n  bodies: [\n    Body(name: \"a\", shape: Ball(radius: 1.0)\n  ],\n)",
+    );
+    match &e {
+        SceneError::Parse {
+            file, line, column, ..
+        } => {
+            assert_eq!(file, "bad.ron");
+            assert_eq!(*line, 5, "{e}");
+            assert!(*column > 0);
+        }
+        other => panic!("{other}"),
+    }
+    assert!(e.to_string().starts_with("bad.ron:5:"), "{e}");
+}
+
+#[test]
+fn wrong_types_report_position_and_body() {
+    let e = error("Scene(bodies: [\n Body(name: \"crate\",\n shape: Ball(radius: \"big\"))])");
+    let SceneError::Parse { line, body, .. } = &e else {
+        panic!("{e}")
+    };
+    assert_eq!(*line, 3);
+    assert_eq!(body.as_deref(), Some("crate"), "{e}");
+}
+
+#[test]
+fn unknown_fields_are_errors_naming_the_body() {
+    let e = error("Scene(bodies: [Body(name: \"b1\", shape: Ball(radius: 1.0), colour: 3)])");
+    let SceneError::Parse { message, body, .. } = &e else {
+        panic!("{e}")
+    };
+    assert!(message.contains("colour"), "{e}");
+    assert_eq!(body.as_deref(), Some("b1"));
+    let e = error("Scene(gravity: (0.0, -9.81, 0.0), wind: 3.0)");
+    assert!(e.to_string().contains("wind"), "{e}");
+}
+
+#[test]
+fn missing_shape_is_an_error() {
+    let e = error("Scene(bodies: [Body(name: \"ghost\", position: (0.0, 1.0, 0.0))])");
+    assert!(e.to_string().contains("shape"), "{e}");
+}
+
+#[test]
+fn non_finite_numbers_name_body_and_field() {
+    let (b, f) = body_field(
+        "Scene(bodies: [Body(name: \"n\", shape: Ball(radius: 1.0), position: (0.0, NaN, 0.0))])",
+    );
+    assert_eq!((b.as_str(), f.as_str()), ("n", "position"));
+    let (_, f) = body_field(
+        "Scene(bodies: [Body(name: \"n\", shape: Ball(radius: 1.0), linear_velocity: (inf, 0.0, 0.0))])",
+    );
+    assert_eq!(f, "linear_velocity");
+    let (_, f) = body_field("Scene(bodies: [Body(name: \"n\", shape: Ball(radius: inf))])");
+    assert_eq!(f, "shape.radius");
+    let e = error("Scene(gravity: (0.0, NaN, 0.0))");
+    assert!(
+        matches!(&e, SceneError::Setting { field, .. } if field == "gravity"),
+        "{e}"
+    );
+}
+
+#[test]
+fn non_positive_mass_size_and_density_name_the_field() {
+    let (b, f) =
+        body_field("Scene(bodies: [Body(name: \"m\", shape: Ball(radius: 1.0), mass: 0.0)])");
+    assert_eq!((b.as_str(), f.as_str()), ("m", "mass"));
+    let (_, f) =
+        body_field("Scene(bodies: [Body(name: \"m\", shape: Ball(radius: 1.0), mass: -2.0)])");
+    assert_eq!(f, "mass");
+    let (_, f) =
+        body_field("Scene(bodies: [Body(name: \"d\", shape: Ball(radius: 1.0), density: -1.0)])");
+    assert_eq!(f, "density");
+    let (_, f) = body_field("Scene(bodies: [Body(name: \"s\", shape: Ball(radius: 0.0))])");
+    assert_eq!(f, "shape.radius");
+    let (_, f) = body_field(
+        "Scene(bodies: [Body(name: \"s\", shape: Cuboid(half_extents: (1.0, -1.0, 1.0)))])",
+    );
+    assert_eq!(f, "shape.half_extents");
+    let (_, f) = body_field(
+        "Scene(bodies: [Body(name: \"s\", shape: Ball(radius: 1.0), mass: 1.0, density: 3.0)])",
+    );
+    assert_eq!(f, "mass");
+    let e = error("Scene(dt: 0.0)");
+    assert!(
+        matches!(&e, SceneError::Setting { field, .. } if field == "dt"),
+        "{e}"
+    );
+}
+
+#[test]
+fn zero_normals_and_bad_meshes_name_the_field() {
+    let (b, f) = body_field(
+        "Scene(bodies: [Body(name: \"g\", shape: HalfSpace(normal: (0.0, 0.0, 0.0)), fixed: true)])",
+    );
+    assert_eq!((b.as_str(), f.as_str()), ("g", "shape.normal"));
+    let (_, f) = body_field(
+        "Scene(bodies: [Body(name: \"t\", shape: TriMesh(vertices: [(0.0,0.0,0.0),(1.0,0.0,0.0),(0.0,0.0,1.0)], indices: [(0, 1, 7)]), fixed: true)])",
+    );
+    assert_eq!(f, "shape.indices");
+    let (_, f) = body_field(
+        "Scene(bodies: [Body(name: \"t\", shape: TriMesh(vertices: [], indices: []), fixed: true)])",
+    );
+    assert!(f == "shape.vertices" || f == "shape.indices", "{f}");
+    let (_, f) = body_field(
+        "Scene(bodies: [Body(name: \"h\", shape: ConvexHull(points: [(0.0,0.0,0.0),(1.0,0.0,0.0)]))])",
+    );
+    assert_eq!(f, "shape.points");
+    // A half-space cannot be dynamic.
+    let (_, f) =
+        body_field("Scene(bodies: [Body(name: \"p\", shape: HalfSpace(normal: (0.0, 1.0, 0.0)))])");
+    assert_eq!(f, "fixed");
+}
+
+#[test]
+fn io_errors_name_the_file() {
+    let e = Scene::load("does/not/exist.ron").unwrap_err();
+    assert!(
+        matches!(&e, SceneError::Io { file, .. } if file == "does/not/exist.ron"),
+        "{e}"
+    );
+}
+
+#[test]
+fn every_asset_loads_and_builds() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/assets");
+    let mut n = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "ron") {
+            let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+            scene
+                .build()
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            n += 1;
+        }
+    }
+    assert!(n >= 2);
+}
+
+#[test]
+fn unknown_fields_inside_a_shape_are_errors() {
+    let e = error("Scene(bodies: [Body(name: \"s\", shape: Ball(radius: 1.0, colour: 2))])");
+    assert!(
+        matches!(&e, SceneError::Parse { body: Some(b), message, .. } if b == "s" && message.contains("colour")),
+        "{e}"
+    );
+}
+
+#[test]
+fn resolver_settings_load_from_the_scene() {
+    use jostle::{MillingtonSettings, ResolverChoice};
+    let scene = Scene::parse(
+        "Scene(resolver: Millington(velocity_iterations: 64, velocity_epsilon: 0.001))",
+        "r.ron",
+    )
+    .unwrap();
+    let Some(ResolverChoice::Millington(s)) = &scene.resolver else {
+        panic!("{:?}", scene.resolver)
+    };
+    assert_eq!(
+        s.velocity_iterations.for_contacts(1000),
+        64,
+        "a plain number is exactly that many picks"
+    );
+    assert_eq!(s.velocity_epsilon, 0.001);
+    assert_eq!(
+        s.position_epsilon,
+        MillingtonSettings::default().position_epsilon,
+        "unset fields keep their defaults"
+    );
+    let scene = Scene::parse(
+        "Scene(resolver: Millington(position_iterations: (per_contact: 2)))",
+        "r.ron",
+    )
+    .unwrap();
+    let Some(ResolverChoice::Millington(s)) = &scene.resolver else {
+        panic!()
+    };
+    assert_eq!(s.position_iterations.for_contacts(100), 200);
+    let e = Scene::parse(
+        "Scene(resolver: Millington(velocity_iteration: 3))",
+        "r.ron",
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("velocity_iteration"), "{e}");
+    assert!(Scene::parse("Scene(resolver: Cyclone())", "r.ron").is_err());
+}

@@ -1,0 +1,153 @@
+//! Sleep and islands through the world: resting bodies sleep, sleeping poses never change,
+//! wake-ups wake exactly the island touched, forces wake, `can_sleep: false` is honoured.
+
+mod common;
+use common::*;
+use jostle::scene::Scene;
+use jostle::{BodyDesc, ShapeDesc, Vec3};
+
+const DT: f32 = 1.0 / 60.0;
+
+#[test]
+fn a_dropped_box_comes_to_rest_and_sleeps_and_then_never_moves() {
+    let scene = Scene::load(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/box_drop.ron")).unwrap();
+    let mut w = scene.build().unwrap();
+    let h = w.find_body("box").unwrap();
+    let mut slept_at = None;
+    for step in 1..=400 {
+        w.step(DT).unwrap();
+        if !w.body(h).unwrap().sleep.awake {
+            slept_at = Some(step);
+            break;
+        }
+    }
+    let step = slept_at.expect("the box must sleep within 400 steps at 60 Hz");
+    eprintln!("box_drop.ron: the box sleeps after step {step}");
+    let pose = (w.body(h).unwrap().position, w.body(h).unwrap().orientation);
+    for _ in 0..300 {
+        w.step(DT).unwrap();
+        let b = w.body(h).unwrap();
+        assert!(!b.sleep.awake);
+        assert_eq!(
+            (b.position, b.orientation),
+            pose,
+            "a sleeping body's pose never changes"
+        );
+    }
+    assert_eq!(w.profile().sleeping_bodies, 1);
+    assert_eq!(w.profile().awake_bodies, 0);
+}
+
+#[test]
+fn a_woken_motionless_body_sleeps_again_after_the_bias_decays_its_motion() {
+    // No gravity, no contacts: a motionless body woken by hand has motion 2ε and qualifies once
+    // 2ε·0.5^(n·dt) < ε, i.e. n·dt > 1. With dt = 0.015 that is the 67th step.
+    let mut w = world(Vec3::ZERO);
+    let h = ball(&mut w, "b", 0.5, 1.0, Vec3::ZERO);
+    let dt = 0.015;
+    let first = (1..1000).find(|_| {
+        w.step(dt).unwrap();
+        !w.body(h).unwrap().sleep.awake
+    });
+    assert_eq!(first, Some(67), "a new body starts with motion 2ε too");
+    w.wake(h).unwrap();
+    let again = (1..1000).find(|_| {
+        w.step(dt).unwrap();
+        !w.body(h).unwrap().sleep.awake
+    });
+    assert_eq!(again, Some(67));
+}
+
+#[test]
+fn a_ball_thrown_into_a_sleeping_pile_wakes_that_island_only() {
+    let mut w = world(Vec3::new(0.0, -9.81, 0.0));
+    ground(&mut w, 0.6, 0.0);
+    let pile = |w: &mut jostle::World, x: f32, tag: &str| -> Vec<jostle::BodyHandle> {
+        (0..3)
+            .map(|k| {
+                w.add_body(
+                    BodyDesc::dynamic(
+                        format!("{tag}{k}"),
+                        ShapeDesc::Cuboid {
+                            half_extents: Vec3::splat(0.5),
+                        },
+                    )
+                    .at(Vec3::new(x, 0.5 + k as f32, 0.0)),
+                )
+                .unwrap()
+            })
+            .collect()
+    };
+    let left = pile(&mut w, -5.0, "l");
+    let right = pile(&mut w, 5.0, "r");
+    run(&mut w, DT, 6.0, |_| {});
+    for &h in left.iter().chain(&right) {
+        assert!(
+            !w.body(h).unwrap().sleep.awake,
+            "the piles must be asleep before the throw"
+        );
+    }
+    let ball = w
+        .add_body(
+            BodyDesc::dynamic("ball", ShapeDesc::Ball { radius: 0.3 })
+                .with_mass(50.0)
+                .at(Vec3::new(-8.0, 1.5, 0.0))
+                .moving(Vec3::new(8.0, 0.0, 0.0), Vec3::ZERO),
+        )
+        .unwrap();
+    let mut woke_left = false;
+    run(&mut w, DT, 1.0, |w| {
+        woke_left |= left.iter().all(|&h| w.body(h).unwrap().sleep.awake);
+        for &h in &right {
+            assert!(
+                !w.body(h).unwrap().sleep.awake,
+                "the other pile must stay asleep"
+            );
+        }
+    });
+    assert!(woke_left, "the whole pile the ball hit must wake");
+    assert!(w.body(ball).is_some());
+}
+
+#[test]
+fn a_force_wakes_a_sleeping_body() {
+    let mut w = world(Vec3::new(0.0, -9.81, 0.0));
+    ground(&mut w, 0.6, 0.0);
+    let h = w
+        .add_body(
+            BodyDesc::dynamic(
+                "box",
+                ShapeDesc::Cuboid {
+                    half_extents: Vec3::splat(0.5),
+                },
+            )
+            .at(Vec3::new(0.0, 0.5, 0.0)),
+        )
+        .unwrap();
+    run(&mut w, DT, 4.0, |_| {});
+    assert!(!w.body(h).unwrap().sleep.awake);
+    w.apply_force(h, Vec3::new(20_000.0, 0.0, 0.0)).unwrap();
+    assert!(w.body(h).unwrap().sleep.awake);
+    let x0 = w.body(h).unwrap().position.x;
+    w.step(DT).unwrap();
+    assert!(
+        w.body(h).unwrap().position.x > x0,
+        "the force acts in the step after it wakes the body"
+    );
+}
+
+#[test]
+fn can_sleep_false_is_honoured() {
+    let mut w = world(Vec3::new(0.0, -9.81, 0.0));
+    ground(&mut w, 0.6, 0.0);
+    let mut d = BodyDesc::dynamic(
+        "insomniac",
+        ShapeDesc::Cuboid {
+            half_extents: Vec3::splat(0.5),
+        },
+    )
+    .at(Vec3::new(0.0, 0.5, 0.0));
+    d.can_sleep = false;
+    let h = w.add_body(d).unwrap();
+    run(&mut w, DT, 8.0, |w| assert!(w.body(h).unwrap().sleep.awake));
+}
