@@ -11,10 +11,14 @@ use glam::{Mat3, Vec3};
 /// `(n, t1, t2)` with `t2 = n × t1`, so contact space is right-handed and
 /// `basis * v_contact` maps a contact-space vector to world space.
 ///
-/// `t1` is built from the world axis least aligned with `n` (X when |n.x| is the smallest
-/// component, else Y or Z), so the result is well conditioned for normals near every axis.
-/// The basis is a pure function of `n`: the same normal always gives the same tangents, which is
-/// what lets a contact's tangent impulses be carried from one step to the next.
+/// `t1` is `n × X` normalised while |n.x| < 0.6 (then |n × X| ≥ 0.8), else `n × Y` (then
+/// |n.y| ≤ 0.8 and |n × Y| ≥ 0.6): well conditioned for every normal, and **continuous** over
+/// the whole region |n.x| < 0.6, which holds the normals of ground, stacks and ±Z walls. An
+/// earlier rule (cross with the least-aligned axis) switched between X and Z under the tiniest
+/// tilt of a vertical normal, turning the tangents by 90° from one step to the next and
+/// garbling warm-started friction. The basis is a pure function of `n`: the same normal always
+/// gives the same tangents, which is what lets a contact's tangent impulses be carried from one
+/// step to the next.
 ///
 /// `n` must be unit length (debug-asserted).
 pub fn contact_basis(n: Vec3) -> Mat3 {
@@ -22,15 +26,7 @@ pub fn contact_basis(n: Vec3) -> Mat3 {
         (n.length_squared() - 1.0).abs() < 1e-3,
         "contact normal must be unit, got {n}"
     );
-    let a = n.abs();
-    // Cross n with the axis it is least aligned with: |n × axis| >= sqrt(2/3).
-    let axis = if a.x <= a.y && a.x <= a.z {
-        Vec3::X
-    } else if a.y <= a.z {
-        Vec3::Y
-    } else {
-        Vec3::Z
-    };
+    let axis = if n.x.abs() < 0.6 { Vec3::X } else { Vec3::Y };
     let t1 = n.cross(axis).normalize();
     let t2 = n.cross(t1);
     Mat3::from_cols(n, t1, t2)
@@ -116,6 +112,23 @@ mod tests {
             if let Some(n) = v.try_normalize() {
                 assert_orthonormal(contact_basis(n), n);
             }
+        }
+    }
+
+    #[test]
+    fn tangents_do_not_jump_when_a_vertical_normal_wobbles() {
+        // Regression: the least-aligned-axis rule picked X or Z depending on which of two tiny
+        // components was smaller, so these two normals got tangents 90° apart.
+        for up in [Vec3::Y, -Vec3::Y, Vec3::Z] {
+            let a = contact_basis((up + Vec3::new(1e-4, 0.0, 2e-4)).normalize());
+            let b = contact_basis((up + Vec3::new(2e-4, 0.0, 1e-4)).normalize());
+            assert!(
+                (a.y_axis - b.y_axis).length() < 1e-3,
+                "{up}: {} vs {}",
+                a.y_axis,
+                b.y_axis
+            );
+            assert!((a.z_axis - b.z_axis).length() < 1e-3);
         }
     }
 
