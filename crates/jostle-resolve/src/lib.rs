@@ -15,10 +15,12 @@ pub mod contact;
 pub mod integrate;
 pub mod millington;
 pub mod resolver;
+pub mod soft_step;
 pub mod solver_body;
 pub mod synthetic;
 
 pub use contact::Contact;
 pub use millington::{MillingtonResolver, MillingtonSettings};
 pub use resolver::{ResolveStats, Resolver, StepContext};
+pub use soft_step::{SoftStepResolver, SoftStepSettings};
 pub use solver_body::{STATIC_BODY, SolverBody};

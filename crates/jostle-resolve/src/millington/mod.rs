@@ -87,6 +87,8 @@ pub struct MillingtonResolver {
     islands: Islands,
     heap: IndexedMaxHeap,
     stamps: Stamps,
+    /// Angular velocities before the position pass (scratch, reused between steps).
+    spins: Vec<jostle_math::Vec3>,
 }
 
 impl MillingtonResolver {
@@ -131,6 +133,8 @@ impl MillingtonResolver {
         stats.prepare_time = start.elapsed();
 
         let start = Instant::now();
+        self.spins.clear();
+        self.spins.extend(bodies.iter().map(|b| b.angular_velocity));
         let mut pass = PositionPass {
             contacts: &mut self.prepared,
             bodies,
@@ -156,9 +160,24 @@ impl MillingtonResolver {
         stats.position_time = start.elapsed();
 
         let start = Instant::now();
+        // Projection turns a rotated body's spin with it (position.rs, `apply_moves`), so the
+        // closing velocities prepared before the position pass are refreshed by the change of
+        // spin of their bodies; without this the velocity pass resolved stale velocities and a
+        // spinning body pushed out of a deep overlap could gain energy (tests/properties.rs).
         // Speculative contacts: the gap left after the position pass decides how much closing
         // speed the contact tolerates this step.
         for p in &mut self.prepared {
+            for side in 0..2 {
+                let index = p.body[side] as usize;
+                if p.body[side] == change::NO_BODY {
+                    continue;
+                }
+                let turned = bodies[index].angular_velocity - self.spins[index];
+                if turned != jostle_math::Vec3::ZERO {
+                    let d = p.basis.transpose() * turned.cross(p.r[side]);
+                    p.velocity += if side == 0 { d } else { -d };
+                }
+            }
             p.gap_velocity = (-p.penetration).max(0.0) / dt;
             p.desired_delta_velocity = desired_delta_velocity(
                 p.velocity.x,

@@ -7,7 +7,7 @@ use super::change::{BodyChange, NO_BODY};
 use super::prepare::{PreparedContact, angular_inertia};
 use super::settings::{MillingtonSettings, Projection};
 use crate::SolverBody;
-use jostle_math::{Vec3, integrate_orientation};
+use jostle_math::{Mat3, Vec3, integrate_orientation};
 
 /// How far each side moves along the normal to resolve a contact (m), and the rotation that
 /// produces the angular part.
@@ -104,8 +104,14 @@ pub fn linear_moves(
 }
 
 /// Moves both bodies by `moves`: the centre of mass along the normal, the orientation by
-/// [`integrate_orientation`] (the lecture's θ' = θ + ½[0, Δθ]θ). The world inverse inertia is
-/// left as it was (first order, see [`SolverBody::inv_inertia`]).
+/// [`integrate_orientation`] (the lecture's θ' = θ + ½[0, Δθ]θ).
+///
+/// A rotated body's world inverse inertia is rotated with it (Cyclone recomputes it after every
+/// projection, `calculateDerivedData`), and so is its angular velocity: projection re-places the
+/// body rigidly, spin included. Leaving ω fixed in world space while the inertia turns changed
+/// ½·ωᵀ·I·ω — a spinning body knocked by a projection gained kinetic energy (found by the
+/// property tests in `tests/properties.rs`); turned with the body, both |L| and the energy are
+/// kept exactly.
 pub fn apply_moves(
     p: &PreparedContact,
     moves: &PenetrationMoves,
@@ -130,7 +136,11 @@ pub fn apply_moves(
         change.linear[side] = linear;
         let rotation = moves.rotation[side];
         if b.rotates() && rotation != Vec3::ZERO {
-            b.orientation = integrate_orientation(b.orientation, rotation);
+            let before = b.orientation;
+            b.orientation = integrate_orientation(before, rotation);
+            let turn = Mat3::from_quat(b.orientation * before.inverse());
+            b.angular_velocity = turn * b.angular_velocity;
+            b.inv_inertia = turn * b.inv_inertia * turn.transpose();
             change.angular[side] = rotation;
         }
     }

@@ -41,11 +41,7 @@ pub enum PickStrategy {
 /// behaviour, and `fixed` stops tiny islands (a single contact that needs several picks after
 /// its neighbours move it) from starving.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(from = "BudgetRepr")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct IterationBudget {
     /// Minimum picks per island, whatever its size. Default 8.
     pub fixed: u32,
@@ -62,41 +58,54 @@ impl Default for IterationBudget {
     }
 }
 
-/// What a scene file may write for a budget: a plain number N (exactly N picks per island,
-/// `velocity_iterations: 64`) or the full form `(fixed: 8, per_contact: 4)`.
+/// A scene file may write a budget as a plain number N (exactly N picks per island,
+/// `velocity_iterations: 64`) or in full, `(fixed: 8, per_contact: 4)` (missing fields take the
+/// defaults, unknown fields are errors). Written by hand rather than as an untagged enum:
+/// serde's untagged buffering lost the fields of the named form `IterationBudget(fixed: ..)`
+/// and silently fell back to the defaults.
 #[cfg(feature = "serde")]
-#[derive(serde::Deserialize)]
-#[serde(untagged)]
-enum BudgetRepr {
-    Picks(u32),
-    Full {
-        #[serde(default = "default_fixed")]
-        fixed: u32,
-        #[serde(default = "default_per_contact")]
-        per_contact: u32,
-    },
-}
-
-#[cfg(feature = "serde")]
-fn default_fixed() -> u32 {
-    IterationBudget::default().fixed
-}
-
-#[cfg(feature = "serde")]
-fn default_per_contact() -> u32 {
-    IterationBudget::default().per_contact
-}
-
-#[cfg(feature = "serde")]
-impl From<BudgetRepr> for IterationBudget {
-    fn from(r: BudgetRepr) -> Self {
-        match r {
-            BudgetRepr::Picks(n) => Self {
-                fixed: n,
-                per_contact: 0,
-            },
-            BudgetRepr::Full { fixed, per_contact } => Self { fixed, per_contact },
+impl<'de> serde::Deserialize<'de> for IterationBudget {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Budget;
+        impl<'de> serde::de::Visitor<'de> for Budget {
+            type Value = IterationBudget;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a number of picks or (fixed: N, per_contact: N)")
+            }
+            fn visit_u64<E: serde::de::Error>(self, n: u64) -> Result<Self::Value, E> {
+                let fixed =
+                    u32::try_from(n).map_err(|_| E::custom(format!("{n} picks is too many")))?;
+                Ok(IterationBudget {
+                    fixed,
+                    per_contact: 0,
+                })
+            }
+            fn visit_i64<E: serde::de::Error>(self, n: i64) -> Result<Self::Value, E> {
+                u64::try_from(n)
+                    .map_err(|_| E::custom(format!("a budget cannot be negative, got {n}")))
+                    .and_then(|n| self.visit_u64(n))
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                mut map: A,
+            ) -> Result<Self::Value, A::Error> {
+                let mut out = IterationBudget::default();
+                while let Some(key) = map.next_key::<String>()? {
+                    match key.as_str() {
+                        "fixed" => out.fixed = map.next_value()?,
+                        "per_contact" => out.per_contact = map.next_value()?,
+                        other => {
+                            return Err(serde::de::Error::unknown_field(
+                                other,
+                                &["fixed", "per_contact"],
+                            ));
+                        }
+                    }
+                }
+                Ok(out)
+            }
         }
+        deserializer.deserialize_any(Budget)
     }
 }
 
@@ -207,5 +216,41 @@ mod tests {
         assert_eq!(b.for_contacts(1), 8);
         assert_eq!(b.for_contacts(100), 400);
         assert_eq!(b.for_contacts(usize::MAX), u32::MAX);
+    }
+}
+
+#[cfg(all(test, feature = "serde"))]
+mod serde_tests {
+    use super::*;
+
+    #[test]
+    fn budgets_round_trip_in_every_form() {
+        let s = MillingtonSettings::default();
+        for cfg in [
+            ron::ser::PrettyConfig::default(),
+            ron::ser::PrettyConfig::default().struct_names(true),
+        ] {
+            let text = ron::ser::to_string_pretty(&s, cfg).unwrap();
+            let back: MillingtonSettings = ron::from_str(&text).unwrap();
+            assert_eq!(back, s, "{text}");
+        }
+        let b: IterationBudget = ron::from_str("64").unwrap();
+        assert_eq!(
+            b,
+            IterationBudget {
+                fixed: 64,
+                per_contact: 0
+            }
+        );
+        let b: IterationBudget = ron::from_str("(per_contact: 2)").unwrap();
+        assert_eq!(
+            b,
+            IterationBudget {
+                fixed: 8,
+                per_contact: 2
+            }
+        );
+        assert!(ron::from_str::<IterationBudget>("(per_contct: 2)").is_err());
+        assert!(ron::from_str::<IterationBudget>("-3").is_err());
     }
 }

@@ -1,0 +1,235 @@
+//! The soft-step resolver: substepped sequential impulses with soft contacts, relax and
+//! restitution (Catto, "Solver2D", 2024; the solver of Box2D v3), in 3D (DESIGN.md,
+//! "Resolver 2: soft step").
+//!
+//! One step of length dt with n substeps of h = dt/n is a linear pipeline:
+//! 1. [`prepare`](constraint::prepare) every contact once on the step-start poses: anchors,
+//!    basis, effective masses, the angular response to unit impulses, softness (static or
+//!    dynamic stiffness, from [`Softness::new`] at h), the approach velocity, and the previous
+//!    step's impulse as the warm start. Contacts with a gap above the speculative margin, or
+//!    between two immovable bodies, take no part.
+//! 2. per substep: integrate gravity (and the implicit gyroscopic torque) into velocities;
+//!    warm start (apply the accumulated impulses); solve every contact once with its soft bias,
+//!    the separation recomputed from the bodies' motion since the start of the step;
+//!    integrate velocities into position and rotation deltas; relax (solve again without
+//!    bias).
+//! 3. restitution, skipped when no contact has e > 0;
+//! 4. store the impulses and the remaining penetration in the contacts, the poses and
+//!    velocities in the bodies.
+//!
+//! Unlike the Millington resolver there is no position projection: overlap is removed by the
+//! soft constraint's bias velocity, which the relax pass then takes back out, so resolving
+//! overlap does not make things bounce. The contacts are solved simultaneously (in a fixed
+//! order, to convergence over the substeps), so a Newton's cradle of touching balls does not
+//! give the textbook one-ball-out answer; momentum and energy are still conserved.
+//!
+//! In: solver bodies and contacts. Out: moved bodies, each contact's impulse and remaining
+//! penetration. Depends on `jostle-math` alone.
+
+// `!(x > 0.0)` is deliberate: it is true for NaN, which must take the "do nothing" branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod body_state;
+pub mod constraint;
+pub mod gyroscopic;
+pub mod integrate;
+pub mod settings;
+pub mod softness;
+pub mod solve;
+
+pub use body_state::BodyState;
+pub use constraint::SoftContact;
+pub use settings::SoftStepSettings;
+pub use softness::Softness;
+
+use crate::{Contact, ResolveStats, Resolver, STATIC_BODY, SolverBody, StepContext};
+use jostle_math::Mat3;
+use std::time::{Duration, Instant};
+
+/// The soft-step resolver (see the module docs). Holds its settings and scratch buffers
+/// reused from step to step; its only memory between steps is the contacts' impulses, which
+/// the caller carries, so swapping resolvers mid-simulation is safe.
+#[derive(Clone, Debug, Default)]
+pub struct SoftStepResolver {
+    /// The settings used by the next step; change them freely between steps.
+    pub settings: SoftStepSettings,
+    states: Vec<BodyState>,
+    inertia: Vec<Mat3>,
+    constraints: Vec<SoftContact>,
+    /// For each constraint, the index of its contact in the input.
+    sources: Vec<u32>,
+}
+
+impl SoftStepResolver {
+    /// A resolver with the given settings.
+    pub fn new(settings: SoftStepSettings) -> Self {
+        Self {
+            settings,
+            ..Self::default()
+        }
+    }
+
+    /// The contacts as the last step solved them (only those that took part), for diagnostics.
+    pub fn constraints(&self) -> &[SoftContact] {
+        &self.constraints
+    }
+
+    /// Loads the body states and, with the gyroscopic term on, the step-start inertia tensors.
+    fn load_bodies(&mut self, bodies: &[SolverBody]) {
+        self.states.clear();
+        self.states.extend(bodies.iter().map(BodyState::from_body));
+        if let Some(s) = self.states.get_mut(STATIC_BODY as usize) {
+            *s = BodyState::STATIC;
+        }
+        self.inertia.clear();
+        if self.settings.gyroscopic {
+            self.inertia.extend(bodies.iter().map(|b| {
+                if b.rotates() {
+                    gyroscopic::inertia_of(b.inv_inertia).unwrap_or(Mat3::ZERO)
+                } else {
+                    Mat3::ZERO
+                }
+            }));
+            if let Some(i) = self.inertia.get_mut(STATIC_BODY as usize) {
+                *i = Mat3::ZERO;
+            }
+        }
+    }
+
+    /// Prepares the contacts; returns whether any has restitution.
+    fn prepare_contacts(&mut self, bodies: &[SolverBody], contacts: &[Contact], h: f32) -> bool {
+        let s = &self.settings;
+        // A spring stiffer than a quarter of the substep rate is not resolved by the substep
+        // and turns into jitter; Box2D v3 caps its contact hertz the same way.
+        let cap = 0.25 / h;
+        let dynamic = Softness::new(s.contact_hertz.min(cap), s.damping_ratio, h);
+        let fixed = Softness::new(s.static_hertz.min(cap), s.damping_ratio, h);
+        // The stored impulse is the step's (per-substep impulse × substeps); one substep's
+        // share is the warm start.
+        let warm = if s.warm_start {
+            1.0 / s.substeps.max(1) as f32
+        } else {
+            0.0
+        };
+        self.constraints.clear();
+        self.sources.clear();
+        let mut any_restitution = false;
+        for (i, c) in contacts.iter().enumerate() {
+            if let Some(sc) =
+                constraint::prepare(c, bodies, s.speculative_margin, fixed, dynamic, warm)
+            {
+                any_restitution |= sc.restitution > 0.0;
+                self.constraints.push(sc);
+                self.sources.push(i as u32);
+            }
+        }
+        any_restitution
+    }
+}
+
+impl Resolver for SoftStepResolver {
+    fn name(&self) -> &'static str {
+        "soft-step"
+    }
+
+    /// The pipeline of the module docs. Each contact's `impulse` is overwritten with the
+    /// impulse of the step in contact space on A, taken as the final per-substep accumulated
+    /// impulse × substeps (≈ force·dt, the same meaning as the Millington resolver's, so the
+    /// warm start survives a change of substep count or resolver); `penetration` with the
+    /// overlap left at the end of the step. Contacts that took no part get a zero impulse.
+    fn step(
+        &mut self,
+        bodies: &mut [SolverBody],
+        contacts: &mut [Contact],
+        ctx: &StepContext,
+    ) -> ResolveStats {
+        let mut stats = ResolveStats::default();
+        let substeps = self.settings.substeps.max(1);
+        let h = ctx.dt / substeps as f32;
+        let inv_h = if h > 0.0 { 1.0 / h } else { 0.0 };
+
+        let start = Instant::now();
+        self.load_bodies(bodies);
+        let any_restitution = self.prepare_contacts(bodies, contacts, h);
+        stats.prepare_time = start.elapsed();
+
+        let mut integrate_time = Duration::ZERO;
+        let mut solve_time = Duration::ZERO;
+        let mut relax_time = Duration::ZERO;
+        let push_out = self.settings.max_push_out;
+        for _ in 0..substeps {
+            let t = Instant::now();
+            if self.settings.gyroscopic {
+                integrate::integrate_velocities_gyroscopic(
+                    &mut self.states,
+                    &self.inertia,
+                    ctx.gravity,
+                    h,
+                );
+            } else {
+                integrate::integrate_velocities(&mut self.states, ctx.gravity, h);
+            }
+            integrate_time += t.elapsed();
+
+            let t = Instant::now();
+            solve::warm_start(&mut self.constraints, &mut self.states);
+            solve::solve(&mut self.constraints, &mut self.states, inv_h, push_out);
+            solve_time += t.elapsed();
+
+            let t = Instant::now();
+            integrate::integrate_positions(&mut self.states, h);
+            integrate_time += t.elapsed();
+
+            let t = Instant::now();
+            for _ in 0..self.settings.relax_iterations {
+                solve::relax(&mut self.constraints, &mut self.states, inv_h);
+            }
+            relax_time += t.elapsed();
+        }
+        let t = Instant::now();
+        let threshold = self.settings.restitution_threshold;
+        if any_restitution
+            && self
+                .constraints
+                .iter()
+                .any(|c| solve::bounces(c, threshold))
+        {
+            for _ in 0..self.settings.restitution_iterations {
+                let correction =
+                    solve::restitution(&mut self.constraints, &mut self.states, threshold, inv_h);
+                if !(correction > SoftStepSettings::RESTITUTION_TOLERANCE) {
+                    break;
+                }
+            }
+        }
+        relax_time += t.elapsed();
+
+        let t = Instant::now();
+        for c in contacts.iter_mut() {
+            c.impulse = jostle_math::Vec3::ZERO;
+        }
+        for (sc, &i) in self.constraints.iter().zip(&self.sources) {
+            let c = &mut contacts[i as usize];
+            c.impulse = solve::accumulated(sc) * substeps as f32;
+            let (a, b) = (&self.states[sc.a as usize], &self.states[sc.b as usize]);
+            c.penetration = -sc.separation(a, b);
+        }
+        for (body, state) in bodies.iter_mut().zip(&self.states).skip(1) {
+            state.store(body);
+            body.last_acceleration = if body.inv_mass > 0.0 {
+                ctx.gravity
+            } else {
+                jostle_math::Vec3::ZERO
+            };
+        }
+        stats.integrate_time = integrate_time + t.elapsed();
+        // The biased solve resolves overlap (the "position" work); relax and restitution are
+        // pure velocity work.
+        stats.position_time = solve_time;
+        stats.velocity_time = relax_time;
+        let n = self.constraints.len() as u32;
+        stats.position_iterations = n.saturating_mul(substeps);
+        stats.velocity_iterations = n.saturating_mul(substeps * self.settings.relax_iterations);
+        stats
+    }
+}
