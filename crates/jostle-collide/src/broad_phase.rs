@@ -26,6 +26,7 @@ use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhWorkspace};
 
 /// Two colliders whose enlarged bounding boxes overlap; the lower handle first.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ColliderPair(pub ColliderHandle, pub ColliderHandle);
 
 impl ColliderPair {

@@ -76,6 +76,7 @@ pub fn body_pose(body: &RigidBody) -> Pose {
 /// An opaque, generational, `Copy` handle to a collider in a [`ColliderSet`].
 /// Ordered by slot index, then generation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ColliderHandle {
     index: u32,
     generation: u32,

@@ -5,7 +5,7 @@
 //! states it reads. Out: candidate [`ColliderPair`]s, [`BodyContact`]s in jostle's convention
 //! (normal from body B toward body A, penetration positive on overlap, at most four points per
 //! manifold, warm-start impulses carried by feature id), touching [`CollisionEvent`]s, ray and
-//! overlap queries, and mass properties of shape descriptions.
+//! overlap queries, mass properties of shape descriptions, and display meshes of colliders.
 //! It is the only jostle crate that names parry types (re-exported as [`parry3d`]); it depends
 //! on `jostle-math` and `jostle-body` and knows nothing of the resolver or of sleep islands.
 //!
@@ -15,6 +15,7 @@
 
 pub mod broad_phase;
 pub mod collider;
+pub mod display;
 pub mod mass;
 pub mod material;
 pub mod narrow_phase;
@@ -25,6 +26,7 @@ pub mod shape;
 
 pub use broad_phase::{BroadPhase, ColliderPair};
 pub use collider::{Collider, ColliderHandle, ColliderSet, body_pose};
+pub use display::DisplayMesh;
 pub use mass::{MassProps, mass_properties};
 pub use material::Material;
 pub use narrow_phase::{BodyContact, CollisionEvent, NarrowPhase, NarrowStats};

@@ -28,6 +28,7 @@ use std::borrow::Cow;
 
 /// One contact point between two bodies, ready for the resolver.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BodyContact {
     /// Body A: the normal points toward it. The dynamic body when the other is fixed.
     pub a: BodyHandle,
@@ -52,6 +53,7 @@ pub struct BodyContact {
 /// Two bodies started or stopped touching (some contact point with penetration ≥ 0) during an
 /// update. The lower body handle comes first.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum CollisionEvent {
     /// The bodies touch now and did not at the previous update.
     Started(BodyHandle, BodyHandle),
@@ -75,6 +77,7 @@ pub struct NarrowStats {
 
 /// Per-point data kept in parry's manifolds.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct PointData {
     impulse: Vec3,
 }
@@ -83,13 +86,17 @@ type Manifold = ContactManifold<(), PointData>;
 
 /// What a pair's manifolds were last computed for.
 #[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct Computed {
     pos12: Pose,
     prediction: f32,
+    /// Identities (addresses) of the two shapes, so a replaced shape forces a recompute.
+    /// Meaningless once serialised: [`NarrowPhase::rebind_shapes`] refreshes them on restore.
     shapes: (usize, usize),
 }
 
 #[derive(Clone)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct PairState {
     pair: ColliderPair,
     manifolds: Vec<Manifold>,
@@ -110,6 +117,7 @@ impl PairState {
 
 /// Where a contact of `contacts()` lives: pair, manifold and point indices.
 #[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct PointSlot {
     pair: u32,
     manifold: u32,
@@ -118,6 +126,7 @@ struct PointSlot {
 
 /// The narrow phase. Keep one per world and call [`NarrowPhase::update`] once per step.
 #[derive(Clone, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct NarrowPhase {
     pairs: Vec<PairState>,
     contacts: Vec<BodyContact>,
@@ -137,6 +146,23 @@ impl std::fmt::Debug for NarrowPhase {
 }
 
 impl NarrowPhase {
+    /// After a restore (a snapshot, or colliders rebuilt from the same descriptions), points
+    /// the reuse records at the current shapes. The reuse test compares shape identities to
+    /// notice a replaced shape; addresses do not survive serialisation, and without this every
+    /// pair would be recomputed instead of reused on the first step, so a restored run would
+    /// not continue bit for bit. Pairs whose colliders are gone are left to be dropped.
+    pub fn rebind_shapes(&mut self, colliders: &ColliderSet) {
+        for state in &mut self.pairs {
+            let (Some(c1), Some(c2)) = (colliders.get(state.pair.0), colliders.get(state.pair.1))
+            else {
+                continue;
+            };
+            if let Some(computed) = state.computed.as_mut() {
+                computed.shapes = (shape_id(c1), shape_id(c2));
+            }
+        }
+    }
+
     /// An empty narrow phase.
     pub fn new() -> Self {
         Self::default()
