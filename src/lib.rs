@@ -30,18 +30,23 @@ pub mod run;
 #[cfg(feature = "scene")]
 pub mod scene;
 pub mod settings;
+pub mod snapshot;
 mod stages;
+pub mod view;
 pub mod world;
 
 pub use body_desc::{BodyDesc, BodyError, MassSpec};
 pub use jostle_body::{BodyHandle, RigidBody};
 pub use jostle_collide::{
-    BodyContact, CollideSettings, CollisionEvent, Material, RayHit, ShapeDesc,
+    BodyContact, CollideSettings, CollisionEvent, DisplayMesh, Material, RayHit, ShapeDesc,
 };
 pub use jostle_math::{Mat3, Quat, Vec3};
-pub use jostle_resolve::{MillingtonResolver, MillingtonSettings, Resolver};
+pub use jostle_resolve::{
+    MillingtonResolver, MillingtonSettings, Resolver, SoftStepResolver, SoftStepSettings,
+};
 pub use profile::StepProfile;
 pub use settings::{ResolverChoice, WorldSettings};
+pub use view::{BodyView, PlaneView};
 pub use world::{StepError, StepReport, World};
 
 /// The engine's layers, re-exported for users who swap or extend one of them.

@@ -8,15 +8,12 @@ use std::time::Duration;
 /// The header of a trace file, exactly.
 pub const TRACE_HEADER: &str = "step,time,body,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz,awake";
 
-/// Writes one CSV row per dynamic body: the state of `world` after `step` steps.
-/// Numbers are printed in Rust's shortest round-trip form, so a trace is bit-exact.
-pub fn write_trace_rows(
-    out: &mut impl Write,
-    world: &World,
-    step: u64,
-    dt: f32,
-) -> std::io::Result<()> {
-    let time = step as f64 * dt as f64;
+/// Writes one CSV row per dynamic body: the state of `world` now, labelled with the world's own
+/// step count and simulated time, so a run continued from a snapshot numbers its rows as the
+/// uninterrupted run does. Numbers are printed in Rust's shortest round-trip form, so a trace
+/// is bit-exact.
+pub fn write_trace_rows(out: &mut impl Write, world: &World) -> std::io::Result<()> {
+    let (time, step) = world.time();
     for (_, name, b) in world.bodies() {
         if b.is_fixed() {
             continue;
@@ -102,7 +99,8 @@ pub fn median(times: &[Duration]) -> Duration {
 }
 
 /// Steps `world` `steps` times with `dt`, calling `observe(world, step)` after every step
-/// (step counts from 1), and summarises.
+/// (`step` is the world's step count, so it continues from a restored snapshot), and
+/// summarises.
 pub fn run(
     world: &mut World,
     steps: u64,
@@ -132,7 +130,7 @@ pub fn run(
             (false, Some(_)) => s.all_asleep_step = None,
             _ => {}
         }
-        observe(world, step).map_err(|e| RunError::Io(e.to_string()))?;
+        observe(world, world.time().1).map_err(|e| RunError::Io(e.to_string()))?;
     }
     s.steps = steps;
     let names = world.profile().stages().map(|(n, _)| n);
@@ -156,4 +154,102 @@ pub enum RunError {
     /// The observer failed to write.
     #[error("write failed: {0}")]
     Io(String),
+}
+
+/// A world ready to run, from a scene file or a snapshot.
+pub struct RunSetup {
+    /// The world.
+    pub world: World,
+    /// The scene's name (for a snapshot: the scene it was taken from).
+    pub name: String,
+    /// The time step: the scene's `dt`, or the snapshot's.
+    pub dt: f32,
+    /// The scene's `steps` (for a snapshot: 600, the scene default).
+    pub steps: u64,
+    /// The scene's camera, if it sets one (snapshots carry none).
+    #[cfg(feature = "scene")]
+    pub camera: Option<crate::scene::Camera>,
+}
+
+/// Overrides a command line applies on top of a scene's or snapshot's settings.
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    /// Another resolver.
+    pub resolver: Option<crate::ResolverChoice>,
+    /// Sleeping on or off.
+    pub sleep: Option<bool>,
+}
+
+/// Loads a scene file, or a snapshot written by `jostle run --snapshot` (recognised by its
+/// first item, `Snapshot(`), applies the overrides and builds the world.
+#[cfg(feature = "scene")]
+pub fn load(path: &std::path::Path, overrides: &Overrides) -> Result<RunSetup, LoadError> {
+    use crate::scene::Scene;
+    use crate::snapshot::Snapshot;
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| LoadError::Io(format!("{file}: cannot read: {e}")))?;
+    if Snapshot::is_snapshot_text(&text) {
+        let mut snapshot = Snapshot::parse(&text, &file)?;
+        if let Some(r) = &overrides.resolver {
+            snapshot.settings.resolver = r.clone();
+        }
+        if let Some(on) = overrides.sleep {
+            snapshot.settings.sleep.enabled = on;
+        }
+        let (name, dt) = (snapshot.scene.clone(), snapshot.dt);
+        let world = World::from_snapshot(snapshot).map_err(|e| match e {
+            crate::snapshot::SnapshotError::Invalid { message, .. } => {
+                crate::snapshot::SnapshotError::Invalid {
+                    file: file.clone(),
+                    message,
+                }
+            }
+            other => other,
+        })?;
+        return Ok(RunSetup {
+            world,
+            name,
+            dt,
+            steps: 600,
+            camera: None,
+        });
+    }
+    let scene = Scene::parse(&text, &file)?;
+    let mut settings = scene.settings();
+    if let Some(r) = &overrides.resolver {
+        settings.resolver = r.clone();
+    }
+    if let Some(on) = overrides.sleep {
+        settings.sleep.enabled = on;
+    }
+    let world = scene.build_with(settings).map_err(|e| match e {
+        crate::scene::SceneError::Body { error, .. } => crate::scene::SceneError::Body {
+            file: file.clone(),
+            error,
+        },
+        other => other,
+    })?;
+    Ok(RunSetup {
+        world,
+        name: scene.name,
+        dt: scene.dt,
+        steps: scene.steps as u64,
+        camera: scene.camera,
+    })
+}
+
+/// Why a scene or snapshot could not be loaded.
+#[cfg(feature = "scene")]
+#[derive(Clone, Debug, thiserror::Error, PartialEq)]
+pub enum LoadError {
+    /// The file could not be read.
+    #[error("{0}")]
+    Io(String),
+    /// A bad scene.
+    #[error(transparent)]
+    Scene(#[from] crate::scene::SceneError),
+    /// A bad snapshot.
+    #[error(transparent)]
+    Snapshot(#[from] crate::snapshot::SnapshotError),
 }

@@ -3,11 +3,13 @@
 
 use jostle_collide::CollideSettings;
 use jostle_math::Vec3;
-use jostle_resolve::{MillingtonResolver, MillingtonSettings, Resolver};
+use jostle_resolve::{
+    MillingtonResolver, MillingtonSettings, Resolver, SoftStepResolver, SoftStepSettings,
+};
 use jostle_sleep::SleepSettings;
 
 /// Which resolver a world uses, with its settings. In a scene file:
-/// `resolver: Millington(velocity_iterations: 64)`.
+/// `resolver: Millington(velocity_iterations: 64)` or `resolver: SoftStep(substeps: 8)`.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(
     feature = "serde",
@@ -18,10 +20,13 @@ pub enum ResolverChoice {
     /// The seed lecture's resolver: worst-first position pass by nonlinear projection, then
     /// worst-first velocity pass with micro-collisions and 3×3 friction impulses.
     Millington(#[cfg_attr(feature = "serde", serde(default))] MillingtonSettings),
+    /// Catto's soft step (Box2D v3's solver): substepped sequential impulses with soft
+    /// contacts, warm starting, relax and restitution passes, and an implicit gyroscopic term.
+    SoftStep(#[cfg_attr(feature = "serde", serde(default))] SoftStepSettings),
 }
 
 impl Default for ResolverChoice {
-    /// The best resolver the engine has: today the Millington resolver (the only one).
+    /// The Millington resolver, until the benchmarks decide between the two.
     fn default() -> Self {
         Self::Millington(MillingtonSettings::default())
     }
@@ -36,9 +41,7 @@ impl ResolverChoice {
     pub fn from_name(name: &str) -> Result<Self, String> {
         match name {
             "millington" => Ok(Self::Millington(MillingtonSettings::default())),
-            "soft-step" => {
-                Err("the soft-step resolver is not part of this build yet; use `millington`".into())
-            }
+            "soft-step" => Ok(Self::SoftStep(SoftStepSettings::default())),
             other => Err(format!(
                 "unknown resolver `{other}`; expected one of: {}",
                 Self::NAMES.join(", ")
@@ -50,6 +53,7 @@ impl ResolverChoice {
     pub fn name(&self) -> &'static str {
         match self {
             Self::Millington(_) => "millington",
+            Self::SoftStep(_) => "soft-step",
         }
     }
 
@@ -57,12 +61,14 @@ impl ResolverChoice {
     pub fn build(&self) -> Box<dyn Resolver> {
         match self {
             Self::Millington(s) => Box::new(MillingtonResolver::new(s.clone())),
+            Self::SoftStep(s) => Box::new(SoftStepResolver::new(s.clone())),
         }
     }
 }
 
 /// Everything a [`crate::World`] is configured with.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct WorldSettings {
     /// Gravity (m/s²). Default (0, −9.81, 0).
     pub gravity: Vec3,

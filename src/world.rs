@@ -48,17 +48,22 @@ pub struct StepReport {
 
 /// A physics world: add bodies, call [`World::step`].
 pub struct World {
-    settings: WorldSettings,
-    bodies: BodySet,
-    colliders: ColliderSet,
-    names: Vec<String>,
+    pub(crate) settings: WorldSettings,
+    pub(crate) bodies: BodySet,
+    pub(crate) colliders: ColliderSet,
+    /// Display meshes and planes for [`crate::view`], built on first view.
+    pub(crate) display: crate::view::DisplayCache,
+    pub(crate) names: Vec<String>,
+    /// How every collider was made, in insertion order, so a snapshot can rebuild them with
+    /// the same handles.
+    pub(crate) records: Vec<crate::snapshot::ColliderRecord>,
     broad: BroadPhase,
-    narrow: NarrowPhase,
-    islands: IslandSet,
+    pub(crate) narrow: NarrowPhase,
+    pub(crate) islands: IslandSet,
     resolver: Box<dyn Resolver>,
     profile: StepProfile,
-    time: f64,
-    steps: u64,
+    pub(crate) time: f64,
+    pub(crate) steps: u64,
     scratch: Scratch,
 }
 
@@ -70,7 +75,9 @@ impl World {
             settings,
             bodies: BodySet::new(),
             colliders: ColliderSet::default(),
+            display: Default::default(),
             names: Vec::new(),
+            records: Vec::new(),
             broad: BroadPhase::default(),
             narrow: NarrowPhase::default(),
             islands: IslandSet::new(),
@@ -140,8 +147,15 @@ impl World {
         body.sleep.can_sleep = desc.can_sleep;
         body.sleep.motion = 2.0 * self.settings.sleep.threshold;
         let handle = self.bodies.insert(body);
-        self.colliders.insert(Collider {
+        let collider = self.colliders.insert(Collider {
             shape,
+            local_pose,
+            material: desc.material,
+            body: handle,
+        });
+        self.display.insert(collider, &desc.shape);
+        self.records.push(crate::snapshot::ColliderRecord {
+            shape: desc.shape.clone(),
             local_pose,
             material: desc.material,
             body: handle,
@@ -330,6 +344,38 @@ impl World {
             .iter()
             .map(|c| c.penetration)
             .fold(0.0, f32::max)
+    }
+
+    /// A 64-bit hash (FNV-1a) of the exact bits of every body's pose, velocities and sleep
+    /// state, in handle order, and of the step count: two worlds with the same hash are, for
+    /// practical purposes, bit-identical. Used by the determinism tests; handy for users who
+    /// check replays or lockstep networking.
+    pub fn state_hash(&self) -> u64 {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        let mut eat = |bits: u32| {
+            for byte in bits.to_le_bytes() {
+                h = (h ^ byte as u64).wrapping_mul(0x0000_0100_0000_01b3);
+            }
+        };
+        eat(self.steps as u32);
+        for (handle, b) in self.bodies.iter() {
+            eat(handle.index());
+            let floats = [
+                b.position.to_array(),
+                b.linear_velocity.to_array(),
+                b.angular_velocity.to_array(),
+            ];
+            for x in floats
+                .iter()
+                .flatten()
+                .chain(b.orientation.to_array().iter())
+            {
+                eat(x.to_bits());
+            }
+            eat(b.sleep.motion.to_bits());
+            eat(u32::from(b.sleep.awake));
+        }
+        h
     }
 
     /// Total kinetic energy of the dynamic bodies (J).

@@ -19,7 +19,8 @@
 //! threshold 0.3; body `name` "", `position` origin, `rotation` identity (x, y, z, w), zero
 //! velocities, `density` 1000 kg/m³ unless `mass` (kg) is given, `friction` 0.5,
 //! `restitution` 0, damping 0, `can_sleep` true, `fixed` false. `generators` add many bodies
-//! from a few parameters (pyramids, stacks, walls, grids of piles).
+//! from a few parameters (pyramids, stacks, walls, grids of piles). An optional `camera`
+//! ([`Camera`]) fixes the view of renderers; without one they frame the scene themselves.
 //!
 //! Errors never panic and lose nothing: a malformed file names the file, line and column (and
 //! the body around that position when there is one); a bad value names the body and the field.
@@ -86,6 +87,66 @@ pub struct Scene {
     /// Generated bodies, added after `bodies`.
     #[serde(default)]
     pub generators: Vec<Generator>,
+    /// The camera renderers use (`jostle run --render`). Default: none, the renderer frames
+    /// the scene itself.
+    #[serde(default)]
+    pub camera: Option<Camera>,
+}
+
+fn default_camera_position() -> Vec3 {
+    Vec3::new(0.0, 5.0, 15.0)
+}
+fn default_fov() -> f32 {
+    45.0
+}
+
+/// A scene's camera (`camera: Camera(position: (8.0, 6.0, 12.0), target: (0.0, 1.0, 0.0))`):
+/// a perspective view from `position` toward `target`, +Y up.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename = "Camera", deny_unknown_fields)]
+pub struct Camera {
+    /// Where the eye is (m). Default (0, 5, 15).
+    #[serde(default = "default_camera_position")]
+    pub position: Vec3,
+    /// The point looked at, drawn at the image's centre (m). Default the origin.
+    #[serde(default)]
+    pub target: Vec3,
+    /// Vertical field of view (degrees), in (1, 179). Default 45.
+    #[serde(default = "default_fov")]
+    pub fov: f32,
+}
+
+impl Camera {
+    /// Checks the camera: finite numbers, `fov` in (1, 179) degrees, `position` ≠ `target`.
+    /// The error is the offending field (`camera.position`, ...) and what is wrong with it.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        let field = |f: &str| format!("camera.{f}");
+        if !self.position.is_finite() {
+            return Err((
+                field("position"),
+                format!("must be finite, got {}", self.position),
+            ));
+        }
+        if !self.target.is_finite() {
+            return Err((
+                field("target"),
+                format!("must be finite, got {}", self.target),
+            ));
+        }
+        if !(self.fov.is_finite() && self.fov > 1.0 && self.fov < 179.0) {
+            return Err((
+                field("fov"),
+                format!("must be in (1, 179) degrees, got {}", self.fov),
+            ));
+        }
+        if self.position.distance(self.target) <= 1e-4 {
+            return Err((
+                field("target"),
+                format!("must differ from `position` ({})", self.position),
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// One body of a scene file (`Body(...)`).
@@ -234,6 +295,11 @@ impl Scene {
                     format!("must be in (0, 1), got {}", s.bias_base),
                 ));
             }
+        }
+        if let Some(camera) = &self.camera {
+            camera
+                .validate()
+                .map_err(|(field, message)| setting(&field, message))?;
         }
         for body in &self.bodies {
             body.to_desc().map_err(|e| SceneError::Body {

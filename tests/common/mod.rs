@@ -1,14 +1,35 @@
 //! Shared builders for the physics validation tests: small worlds with closed-form answers.
 #![allow(dead_code)]
 
-use jostle::{BodyDesc, BodyHandle, Quat, ShapeDesc, Vec3, World, WorldSettings};
+use jostle::{
+    BodyDesc, BodyHandle, MillingtonSettings, Quat, ResolverChoice, ShapeDesc, SoftStepSettings,
+    Vec3, World, WorldSettings,
+};
 
 /// The time steps every analytic test runs at: 60 Hz and a finer 240 Hz.
 pub const STEPS: [f32; 2] = [1.0 / 60.0, 1.0 / 240.0];
 
+/// Both resolvers with their default settings: every physical test runs with each.
+pub fn resolvers() -> [ResolverChoice; 2] {
+    [
+        ResolverChoice::Millington(MillingtonSettings::default()),
+        ResolverChoice::SoftStep(SoftStepSettings::default()),
+    ]
+}
+
+/// A world with the default resolver.
 pub fn world(gravity: Vec3) -> World {
     World::new(WorldSettings {
         gravity,
+        ..Default::default()
+    })
+}
+
+/// A world with the given resolver.
+pub fn world_with(gravity: Vec3, resolver: &ResolverChoice) -> World {
+    World::new(WorldSettings {
+        gravity,
+        resolver: resolver.clone(),
         ..Default::default()
     })
 }

@@ -1,9 +1,10 @@
 //! The `jostle` command: runs a scene headless with a progress bar, prints a summary table or
-//! one JSON object, and can write a per-step CSV trace.
+//! one JSON object, can write a per-step CSV trace, and can render the run to a PNG or GIF.
 //!
 //! It is a thin shell over the facade: scene loading, the run loop and the trace format live
 //! in `jostle` itself (`jostle::scene`, `jostle::run`), so tests and benches use the same code.
 
+mod render_out;
 mod run_cmd;
 
 use clap::{Parser, Subcommand};

@@ -1,10 +1,13 @@
-//! `jostle run`: step a scene, show progress, print the summary, write the trace.
+//! `jostle run`: step a scene, show progress, print the summary, write the trace, and render
+//! the run to an image or an animation (`--render`, see `render_out`).
 
+use crate::render_out::{self, RenderFlags};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use jostle::ResolverChoice;
-use jostle::run::{RunSummary, TRACE_HEADER, run as run_world, write_trace_rows};
-use jostle::scene::Scene;
+use jostle::run::{
+    Overrides, RunSetup, RunSummary, TRACE_HEADER, load, run as run_world, write_trace_rows,
+};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
@@ -13,7 +16,7 @@ use std::time::Duration;
 /// Arguments of `jostle run`.
 #[derive(Args, Debug)]
 pub struct RunArgs {
-    /// The scene file (.ron).
+    /// The scene file (.ron), or a snapshot written by `--snapshot` to continue from.
     scene: PathBuf,
     /// Steps to run (default: the scene's `steps`).
     #[arg(long)]
@@ -36,27 +39,74 @@ pub struct RunArgs {
     /// Print one JSON object on stdout instead of the table (everything else goes to stderr).
     #[arg(long)]
     json: bool,
+    /// Render the run: FILE.png draws the last frame, FILE.gif animates the run.
+    #[arg(long, value_name = "FILE.png|FILE.gif")]
+    render: Option<PathBuf>,
+    /// GIF: draw every K-th step (default: round(1 / (fps·dt)), so the GIF plays in real time).
+    #[arg(long, value_name = "K", requires = "render")]
+    frame_every: Option<u64>,
+    /// GIF: frames per second of playback (1 to 50).
+    #[arg(long, default_value_t = 30, value_name = "N", requires = "render")]
+    fps: u32,
+    /// Image size in pixels.
+    #[arg(
+        long,
+        default_value = "640x480",
+        value_name = "WxH",
+        requires = "render"
+    )]
+    size: String,
+    /// Draw contact points (red) and normals (yellow).
+    #[arg(long, requires = "render")]
+    contacts: bool,
+    /// After the run, write the world's complete state to this file; `jostle run FILE`
+    /// continues from it bit for bit (trace rows keep counting steps from where it stopped).
+    #[arg(long, value_name = "FILE.ron")]
+    snapshot: Option<PathBuf>,
 }
 
 pub fn run(args: RunArgs) -> Result<(), String> {
-    let scene = Scene::load(&args.scene).map_err(|e| e.to_string())?;
-    let mut settings = scene.settings();
-    if let Some(name) = &args.resolver {
-        settings.resolver = ResolverChoice::from_name(name)?;
-    }
-    if args.no_sleep {
-        settings.sleep.enabled = false;
-    }
-    let dt = args.dt.unwrap_or(scene.dt);
+    let overrides = Overrides {
+        resolver: args
+            .resolver
+            .as_deref()
+            .map(ResolverChoice::from_name)
+            .transpose()?,
+        sleep: args.no_sleep.then_some(false),
+    };
+    let RunSetup {
+        mut world,
+        name: scene_name,
+        dt: scene_dt,
+        steps: scene_steps,
+        camera,
+    } = load(&args.scene, &overrides).map_err(|e| e.to_string())?;
+    let dt = args.dt.unwrap_or(scene_dt);
     if !(dt.is_finite() && dt > 0.0) {
         return Err(format!("--dt must be finite and > 0, got {dt}"));
     }
     if args.every == 0 {
         return Err("--every must be at least 1".into());
     }
-    let steps = args.steps.unwrap_or(scene.steps as u64);
-    let resolver_name = settings.resolver.name();
-    let mut world = scene.build_with(settings).map_err(|e| e.to_string())?;
+    let steps = args.steps.unwrap_or(scene_steps);
+    let resolver_name = world.resolver_name();
+    let last_step = world.time().1 + steps;
+
+    let mut render = match &args.render {
+        Some(path) => {
+            let flags = RenderFlags {
+                path: path.clone(),
+                frame_every: args.frame_every,
+                fps: args.fps,
+                size: args.size.clone(),
+                contacts: args.contacts,
+            };
+            let mut job = render_out::start(&flags, camera.as_ref(), dt)?;
+            job.observe(&world, 0)?;
+            Some(job)
+        }
+        None => None,
+    };
 
     let mut trace = match &args.trace {
         Some(path) => {
@@ -64,7 +114,7 @@ pub fn run(args: RunArgs) -> Result<(), String> {
                 .map_err(|e| format!("{}: cannot create: {e}", path.display()))?;
             let mut w = BufWriter::new(file);
             writeln!(w, "{TRACE_HEADER}")
-                .and_then(|_| write_trace_rows(&mut w, &world, 0, dt))
+                .and_then(|_| write_trace_rows(&mut w, &world))
                 .map_err(|e| e.to_string())?;
             Some(w)
         }
@@ -79,15 +129,18 @@ pub fn run(args: RunArgs) -> Result<(), String> {
         .map_err(|e| e.to_string())?
         .progress_chars("=> "),
     );
-    bar.set_message(scene.name.clone());
+    bar.set_message(scene_name.clone());
     if steps < 200 {
         bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
     }
     let every = args.every;
     let summary = run_world(&mut world, steps, dt, |w, step| {
         bar.inc(1);
+        if let Some(job) = render.as_mut() {
+            job.observe(w, step).map_err(std::io::Error::other)?;
+        }
         match trace.as_mut() {
-            Some(out) if step % every == 0 || step == steps => write_trace_rows(out, w, step, dt),
+            Some(out) if step % every == 0 || step == last_step => write_trace_rows(out, w),
             _ => Ok(()),
         }
     })
@@ -95,6 +148,15 @@ pub fn run(args: RunArgs) -> Result<(), String> {
     bar.finish_and_clear();
     if let Some(mut w) = trace {
         w.flush().map_err(|e| e.to_string())?;
+    }
+    if let Some(job) = render {
+        eprintln!("{}", job.finish(&world)?);
+    }
+    if let Some(path) = &args.snapshot {
+        world
+            .snapshot(&scene_name, dt)
+            .save(path)
+            .map_err(|e| e.to_string())?;
     }
     for (step, name) in &summary.quarantined {
         eprintln!("warning: step {step}: body \"{name}\" went non-finite and was frozen");
@@ -104,10 +166,10 @@ pub fn run(args: RunArgs) -> Result<(), String> {
     if args.json {
         println!(
             "{}",
-            json_summary(&scene.name, resolver_name, dt, bodies, &summary)
+            json_summary(&scene_name, resolver_name, dt, bodies, &summary)
         );
     } else {
-        print_table(&scene.name, resolver_name, dt, bodies, &summary);
+        print_table(&scene_name, resolver_name, dt, bodies, &summary);
     }
     Ok(())
 }

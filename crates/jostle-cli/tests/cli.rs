@@ -147,3 +147,219 @@ fn the_summary_table_names_every_figure() {
         assert!(s.contains(key), "missing {key} in\n{s}");
     }
 }
+
+/// Every kind of bad input the command can be given: it exits non-zero, prints a message on
+/// stderr naming what is wrong (file, line:column, body, field or flag), and never panics.
+#[test]
+fn every_bad_input_exits_non_zero_with_a_precise_message() {
+    let body = |fields: &str| format!("Scene(bodies: [Body(name: \"culprit\", {fields})])");
+    let cases: Vec<(&str, String, Vec<&str>, &[&str])> = vec![
+        (
+            "malformed RON",
+            "Scene(bodies: [Body(name: \"a\", shape: Ball(radius: 1.0)]".into(),
+            vec![],
+            &["bad.ron:1:"],
+        ),
+        (
+            "wrong type",
+            body("shape: Ball(radius: \"big\")"),
+            vec![],
+            &["bad.ron:1:", "culprit"],
+        ),
+        (
+            "unknown field",
+            body("shape: Ball(radius: 1.0), colour: 2"),
+            vec![],
+            &["colour", "culprit"],
+        ),
+        (
+            "missing shape",
+            body("position: (0.0, 1.0, 0.0)"),
+            vec![],
+            &["shape"],
+        ),
+        (
+            "NaN",
+            body("shape: Ball(radius: 1.0), position: (NaN, 0.0, 0.0)"),
+            vec![],
+            &["culprit", "position"],
+        ),
+        (
+            "infinity",
+            body("shape: Ball(radius: inf)"),
+            vec![],
+            &["culprit", "radius"],
+        ),
+        (
+            "negative mass",
+            body("shape: Ball(radius: 1.0), mass: -1.0"),
+            vec![],
+            &["culprit", "mass"],
+        ),
+        (
+            "zero mass",
+            body("shape: Ball(radius: 1.0), mass: 0.0"),
+            vec![],
+            &["culprit", "mass"],
+        ),
+        (
+            "zero density",
+            body("shape: Ball(radius: 1.0), density: 0.0"),
+            vec![],
+            &["culprit", "density"],
+        ),
+        (
+            "zero size",
+            body("shape: Cuboid(half_extents: (1.0, 0.0, 1.0))"),
+            vec![],
+            &["culprit", "half_extents"],
+        ),
+        (
+            "zero normal",
+            body("shape: HalfSpace(normal: (0.0, 0.0, 0.0)), fixed: true"),
+            vec![],
+            &["culprit", "normal"],
+        ),
+        (
+            "empty mesh",
+            body("shape: TriMesh(vertices: [], indices: []), fixed: true"),
+            vec![],
+            &["culprit", "shape."],
+        ),
+        (
+            "mesh index out of range",
+            body(
+                "shape: TriMesh(vertices: [(0.0,0.0,0.0),(1.0,0.0,0.0),(0.0,0.0,1.0)], indices: [(0, 1, 9)]), fixed: true",
+            ),
+            vec![],
+            &["culprit", "indices"],
+        ),
+        (
+            "degenerate hull",
+            body("shape: ConvexHull(points: [(0.0,0.0,0.0),(1.0,0.0,0.0),(2.0,0.0,0.0)])"),
+            vec![],
+            &["culprit", "points"],
+        ),
+        (
+            "negative dt in the scene",
+            "Scene(dt: -0.01)".into(),
+            vec![],
+            &["dt"],
+        ),
+        (
+            "negative --dt",
+            "Scene()".into(),
+            vec!["--dt=-1"],
+            &["--dt"],
+        ),
+        (
+            "zero --every",
+            "Scene()".into(),
+            vec!["--every", "0"],
+            &["--every"],
+        ),
+        (
+            "unknown resolver",
+            "Scene()".into(),
+            vec!["--resolver", "nope"],
+            &["nope", "millington"],
+        ),
+    ];
+    for (i, (what, text, flags, needles)) in cases.into_iter().enumerate() {
+        // bad.ron: the message must name the file; one directory per case, no sharing.
+        let file = temp(&format!("case{i}")).join("bad.ron");
+        std::fs::create_dir_all(file.parent().unwrap()).unwrap();
+        std::fs::write(&file, &text).unwrap();
+        let out = jostle()
+            .arg("run")
+            .args(&flags)
+            .arg(&file)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{what}: accepted");
+        assert!(out.status.code().is_some(), "{what}: killed by a signal");
+        assert!(!err.contains("panicked"), "{what}: panicked: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{what}: message lacks `{n}`: {err}");
+        }
+    }
+}
+
+/// `jostle run SCENE --steps N --snapshot FILE` then `jostle run FILE --steps M` writes, row
+/// for row and bit for bit, the trace of `jostle run SCENE --steps N+M` from step N on
+/// (warm-start impulses, manifolds and sleep state included).
+#[test]
+fn a_snapshot_continues_the_trace_bit_for_bit() {
+    let dir = temp("snapshot");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = asset("determinism.ron");
+    let run = |args: &[&std::ffi::OsStr]| {
+        let out = jostle().arg("run").args(args).output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    let (whole, first, second, snap) = (
+        dir.join("whole.csv"),
+        dir.join("first.csv"),
+        dir.join("second.csv"),
+        dir.join("state.ron"),
+    );
+    run(&[
+        scene.as_os_str(),
+        "--steps".as_ref(),
+        "400".as_ref(),
+        "--trace".as_ref(),
+        whole.as_os_str(),
+    ]);
+    run(&[
+        scene.as_os_str(),
+        "--steps".as_ref(),
+        "150".as_ref(),
+        "--trace".as_ref(),
+        first.as_os_str(),
+        "--snapshot".as_ref(),
+        snap.as_os_str(),
+    ]);
+    run(&[
+        snap.as_os_str(),
+        "--steps".as_ref(),
+        "250".as_ref(),
+        "--trace".as_ref(),
+        second.as_os_str(),
+    ]);
+    let rows = |p: &PathBuf| -> Vec<String> {
+        std::fs::read_to_string(p)
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(String::from)
+            .collect()
+    };
+    let step_of = |row: &String| -> u64 { row.split(',').next().unwrap().parse().unwrap() };
+    let whole = rows(&whole);
+    let second = rows(&second);
+    assert_eq!(
+        step_of(&second[0]),
+        150,
+        "the continued trace starts at the snapshot's step"
+    );
+    let first_difference = |got: &[String], want: Vec<&String>| {
+        assert_eq!(got.len(), want.len(), "row counts differ");
+        if let Some((g, w)) = got.iter().zip(want).find(|(g, w)| g != w) {
+            panic!("first differing row:\n got  {g}\n want {w}");
+        }
+    };
+    first_difference(
+        &second,
+        whole.iter().filter(|r| step_of(r) >= 150).collect(),
+    );
+    // The first part is the whole run's beginning, too.
+    first_difference(
+        &rows(&first),
+        whole.iter().filter(|r| step_of(r) <= 150).collect(),
+    );
+}

@@ -1,0 +1,220 @@
+//! Snapshots: the complete state of a [`crate::World`] — bodies, sleep state, the narrow phase's
+//! persistent manifolds with their warm-start impulses, settings and the clock — serialised
+//! with serde so that a run can stop and continue **bit for bit**: N steps, a snapshot, then M
+//! steps give exactly the trace of N + M steps in one run.
+//!
+//! Files are RON (`Snapshot(format: 1, ...)`); floats are written in Rust's shortest
+//! round-trip form, so nothing is lost. The broad phase is not stored: its pairs are a pure
+//! function of the poses (sorted, filtered exactly), so it is rebuilt on the first step.
+
+use jostle_body::BodyHandle;
+use jostle_collide::{Material, Pose, ShapeDesc};
+
+/// How one collider was made: enough to rebuild it, with the same handle, from a snapshot.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct ColliderRecord {
+    /// The shape description.
+    pub shape: ShapeDesc,
+    /// Pose relative to the body's centre-of-mass frame.
+    pub local_pose: Pose,
+    /// Surface material.
+    pub material: Material,
+    /// The body it is attached to.
+    pub body: BodyHandle,
+}
+
+#[cfg(feature = "scene")]
+pub use file::{SNAPSHOT_FORMAT, Snapshot, SnapshotError};
+
+#[cfg(feature = "scene")]
+mod file {
+    use super::ColliderRecord;
+    use crate::settings::WorldSettings;
+    use crate::world::World;
+    use jostle_body::BodySet;
+    use jostle_collide::{Collider, NarrowPhase};
+    use jostle_sleep::IslandSet;
+    use serde::{Deserialize, Serialize};
+    use std::path::Path;
+    use thiserror::Error;
+
+    /// Version of the snapshot format this build reads and writes.
+    pub const SNAPSHOT_FORMAT: u32 = 1;
+
+    /// The complete state of a world. Make one with [`World::snapshot`], restore it with
+    /// [`World::from_snapshot`], store it with [`Snapshot::save`] / [`Snapshot::load`].
+    #[derive(Clone, Serialize, Deserialize)]
+    #[serde(rename = "Snapshot", deny_unknown_fields)]
+    pub struct Snapshot {
+        /// Format version ([`SNAPSHOT_FORMAT`]).
+        pub format: u32,
+        /// Name of the scene the run came from.
+        pub scene: String,
+        /// The time step the run was using (s); `jostle run SNAPSHOT` continues with it.
+        pub dt: f32,
+        pub(crate) settings: WorldSettings,
+        pub(crate) bodies: BodySet,
+        pub(crate) names: Vec<String>,
+        pub(crate) colliders: Vec<ColliderRecord>,
+        pub(crate) narrow: NarrowPhase,
+        pub(crate) islands: IslandSet,
+        pub(crate) time: f64,
+        pub(crate) steps: u64,
+    }
+
+    /// Why a snapshot could not be read, written or restored.
+    #[derive(Clone, Debug, Error, PartialEq)]
+    pub enum SnapshotError {
+        /// The file could not be read or written.
+        #[error("{file}: {message}")]
+        Io {
+            /// The file.
+            file: String,
+            /// What went wrong.
+            message: String,
+        },
+        /// The file is not a valid snapshot.
+        #[error("{file}:{line}:{column}: {message}")]
+        Parse {
+            /// The file.
+            file: String,
+            /// Line, from 1.
+            line: usize,
+            /// Column, from 1.
+            column: usize,
+            /// What ron reported.
+            message: String,
+        },
+        /// The snapshot is well-formed but cannot be restored.
+        #[error("{file}: {message}")]
+        Invalid {
+            /// The file.
+            file: String,
+            /// What is wrong.
+            message: String,
+        },
+    }
+
+    impl Snapshot {
+        /// Writes the snapshot as RON.
+        pub fn save(&self, path: impl AsRef<Path>) -> Result<(), SnapshotError> {
+            let path = path.as_ref();
+            let io = |message: String| SnapshotError::Io {
+                file: path.display().to_string(),
+                message,
+            };
+            let text = ron::ser::to_string_pretty(
+                self,
+                ron::ser::PrettyConfig::default().struct_names(true),
+            )
+            .map_err(|e| io(e.to_string()))?;
+            std::fs::write(path, text).map_err(|e| io(e.to_string()))
+        }
+
+        /// Reads a snapshot written by [`Snapshot::save`].
+        pub fn load(path: impl AsRef<Path>) -> Result<Snapshot, SnapshotError> {
+            let path = path.as_ref();
+            let file = path.display().to_string();
+            let text = std::fs::read_to_string(path).map_err(|e| SnapshotError::Io {
+                file: file.clone(),
+                message: format!("cannot read: {e}"),
+            })?;
+            Self::parse(&text, &file)
+        }
+
+        /// Parses snapshot text; `file` names its origin in errors.
+        pub fn parse(text: &str, file: &str) -> Result<Snapshot, SnapshotError> {
+            let snapshot: Snapshot = ron::from_str(text).map_err(|e| SnapshotError::Parse {
+                file: file.into(),
+                line: e.span.start.line,
+                column: e.span.start.col,
+                message: e.code.to_string(),
+            })?;
+            if snapshot.format != SNAPSHOT_FORMAT {
+                return Err(SnapshotError::Invalid {
+                    file: file.into(),
+                    message: format!(
+                        "snapshot format {} is not supported (this build reads {SNAPSHOT_FORMAT})",
+                        snapshot.format
+                    ),
+                });
+            }
+            Ok(snapshot)
+        }
+
+        /// Whether `text` looks like a snapshot rather than a scene (its first item is
+        /// `Snapshot(`), so one command can take either.
+        pub fn is_snapshot_text(text: &str) -> bool {
+            text.lines()
+                .map(str::trim)
+                .find(|l| !l.is_empty() && !l.starts_with("//"))
+                .is_some_and(|l| l.starts_with("Snapshot("))
+        }
+    }
+
+    impl World {
+        /// The complete state of the world, for [`World::from_snapshot`]. `scene` and `dt` are
+        /// recorded so that a command-line run can continue where it stopped.
+        pub fn snapshot(&self, scene: &str, dt: f32) -> Snapshot {
+            Snapshot {
+                format: SNAPSHOT_FORMAT,
+                scene: scene.to_string(),
+                dt,
+                settings: self.settings.clone(),
+                bodies: self.bodies.clone(),
+                names: self.names.clone(),
+                colliders: self.records.clone(),
+                narrow: self.narrow.clone(),
+                islands: self.islands.clone(),
+                time: self.time,
+                steps: self.steps,
+            }
+        }
+
+        /// Restores a world from a snapshot; stepping it continues bit for bit.
+        pub fn from_snapshot(snapshot: Snapshot) -> Result<World, SnapshotError> {
+            let invalid = |message: String| SnapshotError::Invalid {
+                file: String::new(),
+                message,
+            };
+            let mut world = World::new(snapshot.settings);
+            world.bodies = snapshot.bodies;
+            for (i, record) in snapshot.colliders.into_iter().enumerate() {
+                if !world.bodies.contains(record.body) {
+                    return Err(invalid(format!(
+                        "collider {i} is attached to {}, which the snapshot does not hold",
+                        record.body
+                    )));
+                }
+                let shape = record
+                    .shape
+                    .build()
+                    .map_err(|e| invalid(format!("collider {i}: {e}")))?;
+                let handle = world.colliders.insert(Collider {
+                    shape,
+                    local_pose: record.local_pose,
+                    material: record.material,
+                    body: record.body,
+                });
+                debug_assert_eq!(
+                    handle.index() as usize,
+                    i,
+                    "colliders are never removed, so handles are dense"
+                );
+                world.display.insert(handle, &record.shape);
+                world.records.push(record);
+            }
+            if snapshot.names.len() < world.bodies.capacity_index() {
+                return Err(invalid("fewer body names than body slots".into()));
+            }
+            world.names = snapshot.names;
+            world.narrow = snapshot.narrow;
+            world.narrow.rebind_shapes(&world.colliders);
+            world.islands = snapshot.islands;
+            world.time = snapshot.time;
+            world.steps = snapshot.steps;
+            Ok(world)
+        }
+    }
+}

@@ -1,0 +1,100 @@
+//! Determinism is a tested contract (STYLE.md §9): the same scene and settings give
+//! bit-identical results across runs, a golden hash pins the final state of a 500-step scene,
+//! and a snapshot continues a run bit for bit.
+//!
+//! The golden hash changes whenever the physics intentionally changes. To update it, run
+//!
+//! ```sh
+//! JOSTLE_UPDATE_GOLDEN=1 cargo test --test determinism
+//! ```
+//!
+//! and commit `tests/golden/determinism_500.hash` with the change that explains it. The hash is
+//! for x86-64 with SSE2 (glam's default there); other targets may round differently.
+
+use jostle::World;
+use jostle::scene::Scene;
+use jostle::snapshot::Snapshot;
+
+const DT: f32 = 1.0 / 60.0;
+
+fn scene(name: &str) -> Scene {
+    Scene::load(format!("{}/assets/{name}", env!("CARGO_MANIFEST_DIR"))).unwrap()
+}
+
+fn hashes(world: &mut World, steps: u32) -> Vec<u64> {
+    (0..steps)
+        .map(|_| {
+            world.step(DT).unwrap();
+            world.state_hash()
+        })
+        .collect()
+}
+
+#[test]
+fn the_same_scene_gives_bit_identical_runs() {
+    let s = scene("determinism.ron");
+    let a = hashes(&mut s.build().unwrap(), 200);
+    let b = hashes(&mut s.build().unwrap(), 200);
+    assert_eq!(a, b);
+    assert!(
+        a.windows(2).any(|w| w[0] != w[1]),
+        "the scene must actually move"
+    );
+}
+
+#[test]
+fn golden_hash_after_500_steps_of_the_determinism_scene() {
+    let mut world = scene("determinism.ron").build().unwrap();
+    let hash = *hashes(&mut world, 500).last().unwrap();
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/golden/determinism_500.hash"
+    );
+    if std::env::var_os("JOSTLE_UPDATE_GOLDEN").is_some() {
+        std::fs::write(path, format!("{hash:016x}\n")).unwrap();
+        return;
+    }
+    let golden =
+        std::fs::read_to_string(path).expect("golden file; see this file's docs to create it");
+    assert_eq!(
+        format!("{hash:016x}"),
+        golden.trim(),
+        "the final state changed; if intended, update the golden hash (see the module docs)"
+    );
+}
+
+/// N steps, snapshot through a file, M steps == N + M steps, bit for bit, every step.
+fn snapshot_continues_exactly(scene_file: &str, n: u32, m: u32) {
+    let s = scene(scene_file);
+    let mut straight = s.build().unwrap();
+    let expected = hashes(&mut straight, n + m);
+
+    let mut first = s.build().unwrap();
+    hashes(&mut first, n);
+    let path = std::env::temp_dir().join(format!(
+        "jostle-snapshot-{}-{scene_file}",
+        std::process::id()
+    ));
+    first.snapshot(&s.name, DT).save(&path).unwrap();
+    let mut resumed = World::from_snapshot(Snapshot::load(&path).unwrap()).unwrap();
+    assert_eq!(
+        resumed.state_hash(),
+        expected[n as usize - 1],
+        "restored state differs"
+    );
+    let continued = hashes(&mut resumed, m);
+    assert_eq!(
+        continued,
+        expected[n as usize..],
+        "{scene_file}: the continued run diverged"
+    );
+    std::fs::remove_file(path).ok();
+}
+
+#[test]
+fn a_snapshot_continues_a_run_bit_for_bit() {
+    // Mixed shapes, a mesh and a pyramid in motion, manifolds reused across the snapshot.
+    snapshot_continues_exactly("determinism.ron", 150, 150);
+    // Sleep state: the box falls asleep after the snapshot (step ≈ 323) exactly as it would.
+    snapshot_continues_exactly("box_drop.ron", 200, 200);
+}

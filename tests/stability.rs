@@ -1,0 +1,234 @@
+//! Stability scenes (issue 6, DESIGN.md "Validation"): stacks, pyramids and mass ratios that
+//! must stand still, and a free spinning box that must flip without losing energy. Each scene
+//! is a file in `assets/` (soft-step resolver, sleeping disabled, so standing still is the
+//! solver's doing and not the sleep system's) and runs here through the whole pipeline.
+//!
+//! Drift is the largest displacement of any box between 2 s and the end of the run.
+//!
+//! The 20 s runs of the two big pyramids take longer than the normal suite should (tens of
+//! seconds in the test profile), so the default tests run them for 8 s and the full 20 s
+//! versions are `#[ignore]`d; run them with
+//! `cargo test -p jostle --test stability -- --ignored`.
+
+use jostle::scene::Scene;
+use jostle::{BodyHandle, ResolverChoice, Vec3, World};
+
+/// The criterion of DESIGN.md: no box moves more than 1 cm between 2 s and the end.
+const MAX_DRIFT: f32 = 0.01;
+
+fn scene(file: &str) -> Scene {
+    Scene::load(format!("{}/assets/{file}", env!("CARGO_MANIFEST_DIR"))).unwrap()
+}
+
+/// What a run of a scene measured.
+struct Outcome {
+    world: World,
+    /// Largest displacement of a dynamic body between 2 s and the end (m).
+    drift: f32,
+    /// Largest penetration seen after 2 s (m).
+    penetration: f32,
+    /// Initial position of each dynamic body.
+    initial: Vec<(BodyHandle, Vec3)>,
+}
+
+/// Runs `file` for `seconds` with the scene's resolver, or `resolver` when given.
+fn run_scene(file: &str, seconds: f32, resolver: Option<ResolverChoice>) -> Outcome {
+    let scene = scene(file);
+    let mut settings = scene.settings();
+    if let Some(r) = resolver {
+        settings.resolver = r;
+    }
+    assert!(
+        !settings.sleep.enabled,
+        "{file}: stability scenes run awake"
+    );
+    let mut world = scene.build_with(settings).unwrap();
+    let dynamic: Vec<BodyHandle> = world
+        .bodies()
+        .filter(|(_, _, b)| !b.is_fixed())
+        .map(|(h, _, _)| h)
+        .collect();
+    let position = |w: &World, h: BodyHandle| w.body(h).unwrap().position;
+    let initial: Vec<_> = dynamic.iter().map(|&h| (h, position(&world, h))).collect();
+    let dt = scene.dt;
+    let settle = (2.0 / dt).round() as u32;
+    let total = (seconds / dt).round() as u32;
+    let mut at_settle = Vec::new();
+    let mut penetration = 0.0f32;
+    for step in 1..=total {
+        let report = world.step(dt).unwrap();
+        assert!(report.quarantined.is_empty(), "{file}: {report:?}");
+        if step == settle {
+            at_settle = dynamic.iter().map(|&h| position(&world, h)).collect();
+        }
+        if step > settle {
+            penetration = penetration.max(world.max_penetration());
+        }
+    }
+    let drift = dynamic
+        .iter()
+        .zip(&at_settle)
+        .map(|(&h, &p)| (position(&world, h) - p).length())
+        .fold(0.0, f32::max);
+    Outcome {
+        world,
+        drift,
+        penetration,
+        initial,
+    }
+}
+
+/// Asserts the drift criterion and that no box fell: every box ends within 5 cm of where it
+/// started.
+fn assert_stands(file: &str, o: &Outcome) {
+    assert!(
+        o.drift <= MAX_DRIFT,
+        "{file}: a box moved {} m after 2 s",
+        o.drift
+    );
+    for &(h, p0) in &o.initial {
+        let p = o.world.body(h).unwrap().position;
+        assert!(
+            (p - p0).length() < 0.05,
+            "{file}: {} moved from {p0} to {p}",
+            o.world.body_name(h).unwrap()
+        );
+    }
+    assert!(
+        o.penetration < 0.02,
+        "{file}: penetration {}",
+        o.penetration
+    );
+}
+
+#[test]
+fn a_20_row_pyramid_stands_still_for_8_s() {
+    let o = run_scene("pyramid_20.ron", 8.0, None);
+    assert_stands("pyramid_20.ron", &o);
+}
+
+/// The full criterion: `cargo test -p jostle --test stability -- --ignored`.
+#[test]
+#[ignore = "20 s of 210 boxes; run with --ignored"]
+fn a_20_row_pyramid_stands_still_for_20_s() {
+    let o = run_scene("pyramid_20.ron", 20.0, None);
+    assert_stands("pyramid_20.ron", &o);
+}
+
+#[test]
+fn a_385_box_3d_pyramid_stands_still_for_8_s() {
+    let o = run_scene("pyramid3d_10.ron", 8.0, None);
+    assert_eq!(o.initial.len(), 385);
+    assert_stands("pyramid3d_10.ron", &o);
+}
+
+/// The full criterion: `cargo test -p jostle --test stability -- --ignored`.
+#[test]
+#[ignore = "20 s of 385 boxes; run with --ignored"]
+fn a_385_box_3d_pyramid_stands_still_for_20_s() {
+    let o = run_scene("pyramid3d_10.ron", 20.0, None);
+    assert_stands("pyramid3d_10.ron", &o);
+}
+
+/// Known failure (issue 6, open): the top box slides ~0.13 m between 2 s and 20 s with the
+/// default soft step (0.094 m with 8 substeps and 2 relax iterations).
+#[test]
+#[ignore = "known failure: top box drifts 0.13 m; run with --ignored"]
+fn a_stack_of_15_boxes_stands_for_20_s() {
+    let o = run_scene("stack_15.ron", 20.0, None);
+    assert_stands("stack_15.ron", &o);
+}
+
+/// Known failure (issue 6, open): the soft contact's spring is scaled by the light box's
+/// effective mass, so it cannot carry the heavy box: it sinks ~0.4 m into the light one and
+/// topples (0.026 m drift with 8 substeps and 2 relax iterations).
+#[test]
+#[ignore = "known failure: the heavy box sinks into the light one; run with --ignored"]
+fn a_light_box_under_a_1000_times_heavier_one_neither_sinks_nor_tips() {
+    let file = "mass_ratio_1000.ron";
+    let o = run_scene(file, 10.0, None);
+    assert_stands(file, &o);
+    let w = &o.world;
+    let light = w.body(w.find_body("light").unwrap()).unwrap();
+    let heavy = w.body(w.find_body("heavy").unwrap()).unwrap();
+    // Resting heights 0.5 and 1.5 m; sinking would show as the heavy box's height dropping.
+    assert!(
+        (light.position.y - 0.5).abs() < 0.01,
+        "light box at {}",
+        light.position
+    );
+    assert!(
+        (heavy.position.y - 1.5).abs() < 0.02,
+        "heavy box at {}",
+        heavy.position
+    );
+    for (name, b) in [("light", light), ("heavy", heavy)] {
+        let up = b.orientation * Vec3::Y;
+        assert!(up.y > 0.9998, "{name} box tipped: up = {up}"); // < 1.2°
+        assert!(
+            (b.position.x.abs()).max(b.position.z.abs()) < 0.01,
+            "{name} box slid to {}",
+            b.position
+        );
+    }
+}
+
+/// Known failure (issue 6, open): the pyramid stays up, but the heavy top box sinks ~5 cm
+/// into the row below (the drift criterion fails at 2 cm).
+#[test]
+#[ignore = "known failure: heavy top sinks 5 cm; run with --ignored"]
+fn a_pyramid_with_a_100_times_heavier_top_box_stays_up() {
+    let file = "pyramid_heavy_top.ron";
+    let o = run_scene(file, 10.0, None);
+    assert_stands(file, &o);
+}
+
+/// Kinetic energies and flips of the spinning box of `dzhanibekov.ron` over `seconds`:
+/// (initial energy, largest relative energy error, flips). A flip is a sign change of the
+/// box's Y axis (the spin axis at the start) along the constant angular momentum.
+fn spin(seconds: f32, resolver: Option<ResolverChoice>) -> (f64, f64, u32) {
+    let scene = scene("dzhanibekov.ron");
+    let mut settings = scene.settings();
+    if let Some(r) = resolver {
+        settings.resolver = r;
+    }
+    let mut world = scene.build_with(settings).unwrap();
+    let h = world.find_body("box").unwrap();
+    let e0 = world.kinetic_energy();
+    let b = world.body(h).unwrap();
+    let momentum_dir = (b.orientation * Vec3::Y).normalize();
+    let mut sign = 1.0f32;
+    let (mut flips, mut worst) = (0u32, 0.0f64);
+    for _ in 0..(seconds / scene.dt).round() as u32 {
+        world.step(scene.dt).unwrap();
+        let b = world.body(h).unwrap();
+        let along = (b.orientation * Vec3::Y).dot(momentum_dir);
+        // Hysteresis: count a flip only once the axis is well past the other side.
+        if along * sign < -0.5 {
+            sign = -sign;
+            flips += 1;
+        }
+        worst = worst.max((world.kinetic_energy() - e0).abs() / e0);
+    }
+    (e0, worst, flips)
+}
+
+#[test]
+fn a_box_spun_about_its_intermediate_axis_flips_and_keeps_its_energy() {
+    let (e0, worst, flips) = spin(10.0, None);
+    assert!(e0 > 0.0);
+    assert!(flips >= 4, "only {flips} flips in 10 s");
+    assert!(worst < 0.02, "kinetic energy off by {:.3}%", 100.0 * worst);
+}
+
+#[test]
+fn without_the_gyroscopic_term_the_box_does_not_flip() {
+    // The regression the setting exists for: a solver that integrates ω without the
+    // gyroscopic torque keeps spinning about the initial axis.
+    let settings = jostle::SoftStepSettings {
+        gyroscopic: false,
+        ..Default::default()
+    };
+    let (_, _, flips) = spin(10.0, Some(ResolverChoice::SoftStep(settings)));
+    assert_eq!(flips, 0);
+}
