@@ -36,6 +36,24 @@ impl Default for SleepState {
     }
 }
 
+/// Whether a body is swept for continuous collision detection (CCD) each step.
+///
+/// CCD stops a fast body at its first contact with static, fixed or sleeping geometry instead
+/// of letting it pass through (tunnel) between two steps. In a scene file: `ccd: Auto`,
+/// `ccd: On` or `ccd: Off`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum CcdMode {
+    /// Swept only in steps where its motion (linear, plus angular times its extent) exceeds
+    /// the world's fraction of its smallest dimension: slow bodies cost nothing. The default.
+    #[default]
+    Auto,
+    /// Swept in every step in which it moves at all.
+    On,
+    /// Never swept: it may tunnel through geometry thinner than one step's motion.
+    Off,
+}
+
 /// A rigid body: mass properties, pose, velocities, damping, accumulated force and torque,
 /// the acceleration of the last step, and sleep state.
 ///
@@ -61,8 +79,15 @@ pub struct RigidBody {
     pub last_acceleration: Vec3,
     /// Sleep state.
     pub sleep: SleepState,
+    /// Continuous collision detection: automatic (default), forced on or off.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub ccd: CcdMode,
     mass: f32,
     inv_mass: f32,
+    /// Body-space inertia tensor, kept alongside its inverse so energy is computed without
+    /// inverting a (possibly badly conditioned) matrix in f32.
+    #[cfg_attr(feature = "serde", serde(default))]
+    inertia_body: Mat3,
     inv_inertia_body: Mat3,
     inv_inertia_world: Mat3,
     force: Vec3,
@@ -86,6 +111,7 @@ impl RigidBody {
         body.fixed = false;
         body.mass = mass;
         body.inv_mass = 1.0 / mass;
+        body.inertia_body = inertia;
         body.inv_inertia_body = inertia.inverse();
         body.update_world_inertia();
         Ok(body)
@@ -102,8 +128,10 @@ impl RigidBody {
             angular_damping: 0.0,
             last_acceleration: Vec3::ZERO,
             sleep: SleepState::default(),
+            ccd: CcdMode::Auto,
             mass: f32::INFINITY,
             inv_mass: 0.0,
+            inertia_body: Mat3::ZERO,
             inv_inertia_body: Mat3::ZERO,
             inv_inertia_world: Mat3::ZERO,
             force: Vec3::ZERO,
@@ -203,17 +231,16 @@ impl RigidBody {
         self.torque = Vec3::ZERO;
     }
 
-    /// Kinetic energy ½·m·|v|² + ½·ω·I·ω (J); zero for a fixed body.
+    /// Kinetic energy ½·m·|v|² + ½·ω·I·ω (J); zero for a fixed body. The rotational part is
+    /// evaluated in body space with the stored inertia (no matrix inversion): inverting the
+    /// world inverse inertia of a needle-like body in f32 lost about 0.1% of its energy, which
+    /// the property tests mistook for energy drift.
     pub fn kinetic_energy(&self) -> f32 {
         if self.fixed {
             return 0.0;
         }
-        let inertia_world = self.inv_inertia_world.inverse();
-        0.5 * self.mass * self.linear_velocity.length_squared()
-            + 0.5
-                * self
-                    .angular_velocity
-                    .dot(inertia_world * self.angular_velocity)
+        let w = self.orientation.inverse() * self.angular_velocity;
+        0.5 * self.mass * self.linear_velocity.length_squared() + 0.5 * w.dot(self.inertia_body * w)
     }
 
     /// Freezes the body where it is: it becomes fixed (immovable, zero velocity, no forces).

@@ -11,6 +11,6 @@ pub mod body;
 pub mod integrate;
 pub mod set;
 
-pub use body::{MassError, RigidBody, SleepState};
+pub use body::{CcdMode, MassError, RigidBody, SleepState};
 pub use integrate::{apply_forces, integrate_body};
 pub use set::{BodyHandle, BodySet};

@@ -131,6 +131,29 @@ impl BroadPhase {
         (p.generation == collider.generation() && !p.unbounded).then_some(p.aabb)
     }
 
+    /// Appends to `out` the colliders of resting bodies (fixed or sleeping: they do not move
+    /// during a step) that may touch `aabb`: those whose enlarged box overlaps it and the
+    /// half-spaces it reaches. Boxes are those of the last update, the poses resting bodies
+    /// keep through the step. Continuous collision detection sweeps a fast body against these.
+    pub fn resting_near(&self, aabb: &Aabb, out: &mut Vec<ColliderHandle>) {
+        for j in self.tree.intersect_aabb(aabb) {
+            if let Some(p) = &self.proxies[j as usize]
+                && !p.awake
+                && p.aabb.intersects(aabb)
+            {
+                out.push(ColliderHandle::new(j, p.generation));
+            }
+        }
+        for &u in &self.unbounded {
+            if let Some(p) = &self.proxies[u as usize]
+                && !p.awake
+                && aabb_halfspace_distance(&p.pose, p.normal, aabb) <= 0.0
+            {
+                out.push(ColliderHandle::new(u, p.generation));
+            }
+        }
+    }
+
     /// Recomputes the candidate pairs: every pair of colliders whose bounding boxes, each
     /// enlarged by `margin` metres on every side, overlap, and that passes the filters of the
     /// module docs. Pass at least half the narrow phase's prediction distance as `margin`.

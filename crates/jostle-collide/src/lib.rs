@@ -9,11 +9,12 @@
 //! It is the only jostle crate that names parry types (re-exported as [`parry3d`]); it depends
 //! on `jostle-math` and `jostle-body` and knows nothing of the resolver or of sleep islands.
 //!
-//! Per step: [`BroadPhase::update`] → [`NarrowPhase::update`] → (resolver) →
-//! [`NarrowPhase::store_impulses`].
+//! Per step: [`BroadPhase::update`] → [`NarrowPhase::update`] → (resolver) → [`ccd::sweep`]
+//! for fast bodies → [`NarrowPhase::store_impulses`].
 #![deny(missing_docs)]
 
 pub mod broad_phase;
+pub mod ccd;
 pub mod collider;
 pub mod display;
 pub mod mass;
@@ -25,6 +26,7 @@ pub mod settings;
 pub mod shape;
 
 pub use broad_phase::{BroadPhase, ColliderPair};
+pub use ccd::{CcdHit, CcdShape, sweep};
 pub use collider::{Collider, ColliderHandle, ColliderSet, body_pose};
 pub use display::DisplayMesh;
 pub use mass::{MassProps, mass_properties};
@@ -34,5 +36,5 @@ pub use parry3d;
 pub use parry3d::math::Pose;
 pub use parry3d::shape::SharedShape;
 pub use query::{RayHit, intersect_shape, ray_cast};
-pub use settings::CollideSettings;
+pub use settings::{CcdSettings, CollideSettings};
 pub use shape::{CompoundPart, ShapeDesc, ShapeError};

@@ -82,8 +82,14 @@ pub fn mass_properties(desc: &ShapeDesc, density: f32) -> Result<MassProps, Shap
     let finite =
         props.local_com.is_finite() && props.inertia.to_cols_array().iter().all(|x| x.is_finite());
     if !(props.mass.is_finite() && props.mass > 0.0 && finite) {
+        // Name the field that made it degenerate: a flat hull's points, otherwise the shape.
+        let field = match desc {
+            ShapeDesc::ConvexHull { .. } => "points",
+            ShapeDesc::Compound { .. } => "parts",
+            _ => "size",
+        };
         return Err(ShapeError::invalid(
-            "shape",
+            field,
             format!(
                 "the {} has no usable mass (mass {})",
                 desc.kind(),

@@ -1,0 +1,409 @@
+//! Continuous collision detection: the earliest time a moving collider touches resting
+//! geometry during a step.
+//!
+//! In: a collider, its body's pose at the start of the step (where contacts were detected) and
+//! at its end (where the resolver integrated it), the colliders and bodies, and the broad phase
+//! whose boxes locate resting (fixed or sleeping) colliders. Out: the fraction of the step at
+//! which the collider would first come within [`CcdSettings::slop`] of one of them.
+//!
+//! The seed lecture's velocity-based resolution ("move them back to the point of first
+//! collision"): the facade moves the body back to that fraction of its motion and keeps its
+//! velocity, so the next step's narrow phase finds a speculative contact and the resolver
+//! resolves the impact. The rest of the step's motion of that one body is dropped (Box2D v3
+//! does the same); nothing is lost that a contact would not have removed anyway.
+//!
+//! How: a linear shape cast ([`cast_shapes`]) of the start pose along the step's translation,
+//! stopping `slop` short; a nonlinear cast ([`cast_shapes_nonlinear`]: the start pose turning
+//! about the centre of mass at the step's rotation vector) when the rotation alone could carry a
+//! point further than the linear test tolerates (for pairs parry cannot cast nonlinearly, such as
+//! half-spaces, conservative advancement on parry's distance query). Every stop is within
+//! `slop` of the surface, never a conservative bound short of it: a body stopped where the next
+//! narrow phase finds no contact would keep its velocity, be stopped again, and hang in the air.
+//! A body already within `slop` of a surface at
+//! the start and still approaching (a cast hit at time 0) is not stopped outright, which would
+//! freeze a fast body sliding along a floor: instead a small core sphere at its centre of mass
+//! is cast, and only a core that would reach the surface (the body crossing it) stops the body.
+//! Moving–moving pairs are not swept: their narrow phase and resolver handle them.
+
+use crate::broad_phase::BroadPhase;
+use crate::collider::{Collider, ColliderHandle, ColliderSet};
+use crate::settings::CcdSettings;
+use jostle_body::BodySet;
+use jostle_math::Vec3;
+use parry3d::bounding_volume::{Aabb, BoundingVolume};
+use parry3d::math::Pose;
+use parry3d::query::{
+    NonlinearRigidMotion, ShapeCastHit, ShapeCastOptions, ShapeCastStatus, Unsupported,
+    cast_shapes, cast_shapes_nonlinear, distance,
+};
+use parry3d::shape::Ball;
+
+/// What CCD needs to know of a collider's shape, computed once when the collider is added.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CcdShape {
+    /// Smallest dimension (m): twice the smallest half extent of the shape's local box. A body
+    /// moving less than a fraction of this per step cannot cross a wall between detections.
+    /// Infinite for unbounded shapes.
+    pub thickness: f32,
+    /// Largest distance (m) from the body's centre of mass to a point of the shape: how far a
+    /// rotation of θ rad moves a point, at most, is θ·extent. Zero for a ball centred on the
+    /// centre of mass, whose surface a rotation does not move.
+    pub extent: f32,
+}
+
+impl CcdShape {
+    /// The thickness and extent of `collider`'s shape, relative to its body's centre of mass.
+    pub fn of(collider: &Collider) -> Self {
+        if collider.is_unbounded() {
+            return Self {
+                thickness: f32::INFINITY,
+                extent: f32::INFINITY,
+            };
+        }
+        let half = collider.shape.compute_local_aabb().half_extents();
+        let sphere = collider.shape.compute_local_bounding_sphere();
+        let centre = collider.local_pose * sphere.center();
+        // A ball turning about its own centre moves no point of its surface.
+        let centred_ball =
+            collider.shape.as_ball().is_some() && centre.length() <= 1e-6 * sphere.radius();
+        Self {
+            thickness: 2.0 * half.min_element(),
+            extent: if centred_ball {
+                0.0
+            } else {
+                centre.length() + sphere.radius()
+            },
+        }
+    }
+
+    /// How far a point of the shape moves at most (m) for a translation of `distance` metres
+    /// and a rotation of `angle` rad about the centre of mass.
+    pub fn motion(&self, distance: f32, angle: f32) -> f32 {
+        distance + angle * self.extent
+    }
+}
+
+/// The first resting collider a sweep touches.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CcdHit {
+    /// Fraction of the motion (0 = start pose, 1 = end pose) at which to stop the body: the
+    /// time of impact, `slop` short.
+    pub fraction: f32,
+    /// The resting collider hit.
+    pub collider: ColliderHandle,
+}
+
+/// Sweeps `collider` from its body's pose `start` to `end` (centre-of-mass poses) against the
+/// resting colliders near the motion (through `broad`'s boxes) and returns the earliest hit,
+/// ties broken by the lower collider handle. `candidates` is scratch space, cleared here.
+///
+/// `None` when nothing is touched, or when the body only grazes what it already touched at the
+/// start (see the module docs). Shape pairs parry cannot cast are skipped.
+#[allow(clippy::too_many_arguments)]
+pub fn sweep(
+    collider: &Collider,
+    shape: &CcdShape,
+    start: Pose,
+    end: Pose,
+    colliders: &ColliderSet,
+    bodies: &BodySet,
+    broad: &BroadPhase,
+    settings: &CcdSettings,
+    candidates: &mut Vec<ColliderHandle>,
+) -> Option<CcdHit> {
+    let delta = end.translation - start.translation;
+    let mut turn = end.rotation * start.rotation.inverse();
+    if turn.w < 0.0 {
+        turn = -turn;
+    }
+    let rotation = turn.to_scaled_axis();
+    let angle = rotation.length();
+    let from = start * collider.local_pose;
+    // The linear cast ignores the rotation; it is enough while the rotation alone moves no
+    // point further than the motion a body may make without CCD.
+    let turning = angle * shape.extent > settings.motion_fraction * shape.thickness;
+    let swept = if turning {
+        let reach = Vec3::splat(shape.extent);
+        let a = Aabb::new(start.translation - reach, start.translation + reach);
+        a.merged(&a.translated(delta))
+    } else {
+        let a = collider.shape.compute_aabb(&from);
+        a.merged(&a.translated(delta))
+    }
+    .loosened(settings.slop);
+
+    candidates.clear();
+    broad.resting_near(&swept, candidates);
+    let mut best: Option<CcdHit> = None;
+    for &handle in candidates.iter() {
+        let Some(target) = colliders.get(handle) else {
+            continue;
+        };
+        let Some(target_body) = bodies.get(target.body) else {
+            continue;
+        };
+        if target.body == collider.body {
+            continue;
+        }
+        let to = target.world_pose(target_body);
+        let hit = if turning {
+            match cast_turning(collider, &from, delta, rotation, target, &to) {
+                Ok(hit) => {
+                    hit.map(|t| back_off(t, shape.motion(delta.length(), angle), settings.slop))
+                }
+                // parry has no nonlinear cast for this pair (half-spaces, composite against
+                // composite): conservative advancement on parry's distance query.
+                Err(Unsupported) => {
+                    let speed = shape.motion(delta.length(), angle);
+                    advance(
+                        collider,
+                        &from,
+                        delta,
+                        rotation,
+                        speed,
+                        target,
+                        &to,
+                        settings.slop,
+                    )
+                }
+            }
+        } else {
+            cast_linear(collider, &from, delta, target, &to, settings.slop)
+        };
+        let fraction = match hit {
+            Some(Impact::At(t)) => t,
+            Some(Impact::AtStart) => match cast_core(shape, start, delta, target, &to) {
+                Some(t) => t,
+                None => continue,
+            },
+            None => continue,
+        };
+        let closer = best.is_none_or(|b| (fraction, handle) < (b.fraction, b.collider));
+        if closer {
+            best = Some(CcdHit {
+                fraction,
+                collider: handle,
+            });
+        }
+    }
+    best
+}
+
+/// A cast's outcome: a time of impact in (0, 1], or contact (within the target distance and
+/// approaching) already at the start.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Impact {
+    At(f32),
+    AtStart,
+}
+
+fn impact(hit: Option<ShapeCastHit>) -> Option<Impact> {
+    let hit = hit?;
+    if hit.status == ShapeCastStatus::PenetratingOrWithinTargetDist || hit.time_of_impact <= 0.0 {
+        Some(Impact::AtStart)
+    } else {
+        Some(Impact::At(hit.time_of_impact.min(1.0)))
+    }
+}
+
+/// Linear cast of the collider at `from` along `delta` (one step = time 1), stopping `slop`
+/// short of `target`.
+fn cast_linear(
+    collider: &Collider,
+    from: &Pose,
+    delta: Vec3,
+    target: &Collider,
+    to: &Pose,
+    slop: f32,
+) -> Option<Impact> {
+    let options = ShapeCastOptions {
+        max_time_of_impact: 1.0,
+        target_distance: slop,
+        stop_at_penetration: false,
+        compute_impact_geometry_on_penetration: false,
+    };
+    let hit = cast_shapes(
+        from,
+        delta,
+        collider.shape.as_ref(),
+        to,
+        Vec3::ZERO,
+        target.shape.as_ref(),
+        options,
+    );
+    impact(hit.ok().flatten())
+}
+
+/// Nonlinear cast: the collider at `from` translating by `delta` while turning by the rotation
+/// vector `rotation` about its body's centre of mass, over one step (time 0 to 1).
+fn cast_turning(
+    collider: &Collider,
+    from: &Pose,
+    delta: Vec3,
+    rotation: Vec3,
+    target: &Collider,
+    to: &Pose,
+) -> Result<Option<Impact>, Unsupported> {
+    // The centre of mass in the collider's frame: the origin of the body frame.
+    let centre = collider.local_pose.inverse().translation;
+    let moving = NonlinearRigidMotion::new(*from, centre, delta, rotation);
+    let resting = NonlinearRigidMotion::constant_position(*to);
+    let hit = cast_shapes_nonlinear(
+        &moving,
+        collider.shape.as_ref(),
+        &resting,
+        target.shape.as_ref(),
+        0.0,
+        1.0,
+        false,
+    )?;
+    Ok(impact(hit))
+}
+
+/// Most distance queries of one conservative advancement.
+const MAX_ADVANCE_ITERATIONS: usize = 64;
+
+/// Conservative advancement (Mirtich 1996): the same motion as [`cast_turning`], for pairs
+/// parry cannot cast nonlinearly. No point of the shape moves faster than `speed` (m per step),
+/// so advancing by (distance − slop/2)/speed can never close the gap below slop/2; it stops
+/// when the gap is within `slop`. `None` when the step ends first, the iterations run out
+/// (a grazing motion that never closes in), or parry has no distance query for the pair.
+#[allow(clippy::too_many_arguments)]
+fn advance(
+    collider: &Collider,
+    from: &Pose,
+    delta: Vec3,
+    rotation: Vec3,
+    speed: f32,
+    target: &Collider,
+    to: &Pose,
+    slop: f32,
+) -> Option<Impact> {
+    let centre = collider.local_pose.inverse().translation;
+    let moving = NonlinearRigidMotion::new(*from, centre, delta, rotation);
+    let mut t = 0.0;
+    for _ in 0..MAX_ADVANCE_ITERATIONS {
+        let pose = moving.position_at_time(t);
+        let gap = distance(&pose, collider.shape.as_ref(), to, target.shape.as_ref())
+            .ok()?
+            .distance;
+        if gap <= slop {
+            return Some(if t == 0.0 {
+                Impact::AtStart
+            } else {
+                Impact::At(t)
+            });
+        }
+        t += (gap - 0.5 * slop) / speed;
+        if t > 1.0 {
+            return None;
+        }
+    }
+    None
+}
+
+/// Stops a nonlinear impact `slop` short, measured along the fastest point's path (`motion`
+/// metres per step); the nonlinear cast has no target distance of its own.
+fn back_off(impact: Impact, motion: f32, slop: f32) -> Impact {
+    match impact {
+        Impact::At(t) if motion > 0.0 => Impact::At((t - slop / motion).max(0.0)),
+        other => other,
+    }
+}
+
+/// Fraction of the step at which a core sphere at the centre of mass (radius a quarter of the
+/// thickness) touches `target`; `None` when it does not, or already does at the start (the body
+/// is deep in the target: a case for the resolver's projection, not for a stop).
+fn cast_core(
+    shape: &CcdShape,
+    start: Pose,
+    delta: Vec3,
+    target: &Collider,
+    to: &Pose,
+) -> Option<f32> {
+    let core = Ball::new(0.25 * shape.thickness);
+    let options = ShapeCastOptions {
+        max_time_of_impact: 1.0,
+        target_distance: 0.0,
+        stop_at_penetration: false,
+        compute_impact_geometry_on_penetration: false,
+    };
+    let from = Pose::from_translation(start.translation);
+    let hit = cast_shapes(
+        &from,
+        delta,
+        &core,
+        to,
+        Vec3::ZERO,
+        target.shape.as_ref(),
+        options,
+    );
+    match impact(hit.ok().flatten())? {
+        Impact::At(t) => Some(t),
+        Impact::AtStart => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use jostle_body::RigidBody;
+    use jostle_math::Quat;
+    use parry3d::shape::SharedShape;
+
+    /// A 0.01 m wall at x ∈ [−0.01, 0] and a ball (r 0.05) at x = 1 whose step ends 1 m
+    /// behind the wall: the sweep stops it `slop` short of the face.
+    #[test]
+    fn sweep_stops_a_ball_short_of_a_thin_wall() {
+        let mut bodies = BodySet::new();
+        let wall = bodies
+            .insert(RigidBody::fixed().with_pose(Vec3::new(-0.005, 0.0, 0.0), Quat::IDENTITY));
+        let ball = bodies.insert(
+            RigidBody::dynamic(1.0, jostle_math::Mat3::IDENTITY)
+                .expect("mass")
+                .with_pose(Vec3::X, Quat::IDENTITY),
+        );
+        let mut colliders = ColliderSet::new();
+        let wall_collider =
+            colliders.insert(Collider::new(SharedShape::cuboid(0.005, 1.0, 1.0), wall));
+        let ball_collider = colliders.insert(Collider::new(SharedShape::ball(0.05), ball));
+        let mut broad = BroadPhase::new();
+        broad.update(&colliders, &bodies, 0.01);
+        let settings = CcdSettings::default();
+        let collider = colliders.get(ball_collider).expect("ball");
+        let shape = CcdShape::of(collider);
+        assert_eq!(shape.thickness, 0.1);
+        assert_eq!(shape.extent, 0.0, "a centred ball's rotation moves nothing");
+        let start = Pose::from_translation(Vec3::X);
+        let end = Pose::from_translation(-Vec3::X);
+        let hit = sweep(
+            collider,
+            &shape,
+            start,
+            end,
+            &colliders,
+            &bodies,
+            &broad,
+            &settings,
+            &mut Vec::new(),
+        )
+        .expect("the ball hits the wall");
+        assert_eq!(hit.collider, wall_collider);
+        // Stop where the ball's surface is `slop` from the face: centre at 0.05 + 0.005.
+        let x = 1.0 - 2.0 * hit.fraction;
+        assert!((x - 0.055).abs() < 1e-4, "stopped at x = {x}");
+        // Moving away, nothing is hit.
+        let away = sweep(
+            collider,
+            &shape,
+            start,
+            Pose::from_translation(Vec3::new(3.0, 0.0, 0.0)),
+            &colliders,
+            &bodies,
+            &broad,
+            &settings,
+            &mut Vec::new(),
+        );
+        assert_eq!(away, None);
+    }
+}
