@@ -1,0 +1,420 @@
+//! Numerical-stability stress suite (issue: "stress-test numerical stability"). Every case runs
+//! with both resolvers and must stay finite, never panic and never quarantine a body; cases
+//! with a physical criterion ("held") assert it where the engine meets it, and the outcome of
+//! every case is printed as a table (`cargo test --test stress -- --nocapture`).
+//!
+//! Heavier variants (100,000-step run, 100-box tower, 1:10,000 mass ratio at length) are
+//! `#[ignore]`d; run them with
+//! `cargo test --release --test stress -- --ignored --nocapture`.
+
+use jostle::{
+    BodyDesc, MillingtonSettings, Quat, ResolverChoice, ShapeDesc, SoftStepSettings, Vec3, World,
+    WorldSettings,
+};
+
+const DT: f32 = 1.0 / 60.0;
+
+fn resolvers() -> [(&'static str, ResolverChoice); 2] {
+    [
+        (
+            "millington",
+            ResolverChoice::Millington(MillingtonSettings::default()),
+        ),
+        (
+            "soft-step",
+            ResolverChoice::SoftStep(SoftStepSettings::default()),
+        ),
+    ]
+}
+
+fn world(resolver: &ResolverChoice) -> World {
+    let mut s = WorldSettings {
+        resolver: resolver.clone(),
+        ..Default::default()
+    };
+    s.sleep.enabled = false;
+    World::new(s)
+}
+
+fn ground(w: &mut World, at: Vec3) {
+    w.add_body(
+        BodyDesc::fixed("ground", ShapeDesc::HalfSpace { normal: Vec3::Y })
+            .at(at)
+            .with_material(0.6, 0.0),
+    )
+    .unwrap();
+}
+
+/// Steps `seconds`, asserting finiteness and no quarantine every step; returns the largest
+/// displacement of any dynamic body between `settle` seconds and the end.
+fn run_checked(w: &mut World, seconds: f32, settle: f32, case: &str) -> f32 {
+    let n = (seconds / DT).round() as u32;
+    let settle_step = (settle / DT).round() as u32;
+    let mut at_settle: Vec<Vec3> = Vec::new();
+    for step in 1..=n {
+        let report = w
+            .step(DT)
+            .unwrap_or_else(|e| panic!("{case}: step refused: {e}"));
+        assert!(
+            report.quarantined.is_empty(),
+            "{case}: quarantined {:?} at step {step}",
+            report.quarantined
+        );
+        if step == settle_step {
+            at_settle = w
+                .bodies()
+                .filter(|(_, _, b)| !b.is_fixed())
+                .map(|(_, _, b)| b.position)
+                .collect();
+        }
+    }
+    for (_, name, b) in w.bodies() {
+        assert!(b.is_finite(), "{case}: {name} went non-finite");
+    }
+    w.bodies()
+        .filter(|(_, _, b)| !b.is_fixed())
+        .zip(&at_settle)
+        .map(|((_, _, b), p)| (b.position - *p).length())
+        .fold(0.0, f32::max)
+}
+
+fn cube(name: &str, half: f32, at: Vec3, mass: f32) -> BodyDesc {
+    BodyDesc::dynamic(
+        name,
+        ShapeDesc::Cuboid {
+            half_extents: Vec3::splat(half),
+        },
+    )
+    .at(at)
+    .with_mass(mass)
+    .with_material(0.6, 0.0)
+}
+
+/// A light box under a heavy one: (drift 1 s → `seconds`, how far the top sank).
+fn mass_ratio(resolver: &ResolverChoice, ratio: f32, seconds: f32) -> (f32, f32) {
+    let mut w = world(resolver);
+    ground(&mut w, Vec3::ZERO);
+    w.add_body(cube("light", 0.5, Vec3::new(0.0, 0.5, 0.0), 1.0))
+        .unwrap();
+    let top = w
+        .add_body(cube("heavy", 0.5, Vec3::new(0.0, 1.5, 0.0), ratio))
+        .unwrap();
+    let drift = run_checked(&mut w, seconds, 1.0, &format!("mass ratio 1:{ratio}"));
+    (drift, 1.5 - w.body(top).unwrap().position.y)
+}
+
+#[test]
+fn mass_ratio_stacks_stay_finite_and_moderate_ratios_hold() {
+    println!(
+        "{:<12} {:>8} {:>10} {:>10}",
+        "resolver", "ratio", "drift m", "sank m"
+    );
+    for (name, r) in resolvers() {
+        for ratio in [10.0, 100.0, 1000.0, 10_000.0] {
+            let (drift, sank) = mass_ratio(&r, ratio, 4.0);
+            println!("{name:<12} {ratio:>8} {drift:>10.4} {sank:>10.4}");
+            // Measured (4 s, 60 Hz): both hold 1:10. At 1:100 and beyond the Millington
+            // resolver lets the heavy box sink through the light one (1.0 m); soft-step holds
+            // 1:100 to 3.4 cm, sinks 0.34 m at 1:1000 and through at 1:10,000. Open work,
+            // reported rather than asserted; finiteness is asserted for every ratio.
+            if ratio <= 10.0 {
+                assert!(
+                    drift < 0.01 && sank < 0.02,
+                    "{name} 1:{ratio}: drift {drift}, sank {sank}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn boxes_from_1_cm_to_100_m_rest_at_their_height() {
+    println!(
+        "{:<12} {:>8} {:>12} {:>10}",
+        "resolver", "size m", "rest error", "drift"
+    );
+    for (name, r) in resolvers() {
+        for half in [0.005f32, 0.05, 0.5, 5.0, 50.0] {
+            let mut w = world(&r);
+            ground(&mut w, Vec3::ZERO);
+            let h = w
+                .add_body(cube(
+                    "box",
+                    half,
+                    Vec3::new(0.0, 1.02 * half, 0.0),
+                    1000.0 * 8.0 * half.powi(3),
+                ))
+                .unwrap();
+            let drift = run_checked(&mut w, 3.0, 1.5, &format!("{name} size {half}"));
+            let err = (w.body(h).unwrap().position.y - half).abs();
+            println!("{name:<12} {:>8} {err:>12.5} {drift:>10.5}", 2.0 * half);
+            // Rests on the ground: not fallen through, not floating.
+            assert!(
+                w.body(h).unwrap().position.y > 0.0,
+                "{name}: {half} fell through"
+            );
+            assert!(
+                err < 0.01 * half.max(0.5),
+                "{name} size {}: rest error {err}",
+                2.0 * half
+            );
+        }
+    }
+}
+
+#[test]
+fn a_box_ten_kilometres_from_the_origin_rests_and_does_not_drift() {
+    for (name, r) in resolvers() {
+        let far = Vec3::new(10_000.0, 0.0, 10_000.0);
+        let mut w = world(&r);
+        ground(&mut w, far);
+        let h = w
+            .add_body(cube("far", 0.5, far + Vec3::new(0.0, 0.5, 0.0), 1000.0))
+            .unwrap();
+        let drift = run_checked(&mut w, 4.0, 1.0, "10 km");
+        let y = w.body(h).unwrap().position.y;
+        println!("{name}: 10 km from the origin: drift {drift} m, rests at y = {y}");
+        // f32 resolves 10 km to ~1 mm; the box must not wander more than a few of those.
+        assert!(
+            drift < 0.01 && (y - 0.5).abs() < 0.02,
+            "{name}: drift {drift}, y {y}"
+        );
+    }
+}
+
+/// Balls shot at `speed` into a static wall `thickness` thick; returns how many of 8 start
+/// offsets ended beyond the wall (tunnelled).
+fn tunnels(resolver: &ResolverChoice, speed: f32, thickness: f32) -> usize {
+    (0..8)
+        .filter(|&k| {
+            let mut s = WorldSettings {
+                gravity: Vec3::ZERO,
+                resolver: resolver.clone(),
+                ..Default::default()
+            };
+            s.sleep.enabled = false;
+            let mut w = World::new(s);
+            w.add_body(BodyDesc::fixed(
+                "wall",
+                ShapeDesc::Cuboid {
+                    half_extents: Vec3::new(thickness / 2.0, 2.0, 2.0),
+                },
+            ))
+            .unwrap();
+            let start = -1.0 - speed * DT * k as f32 / 8.0;
+            let b = w
+                .add_body(
+                    BodyDesc::dynamic("bullet", ShapeDesc::Ball { radius: 0.05 })
+                        .at(Vec3::new(start, 0.0, 0.0))
+                        .moving(Vec3::new(speed, 0.0, 0.0), Vec3::ZERO),
+                )
+                .unwrap();
+            let steps = ((2.0 - start) / (speed * DT)).ceil() as u32 + 2;
+            for _ in 0..steps {
+                w.step(DT).unwrap();
+            }
+            let x = w.body(b).unwrap().position.x;
+            assert!(x.is_finite());
+            x > 0.0
+        })
+        .count()
+}
+
+#[test]
+fn fast_bodies_into_thin_walls_stay_finite_and_the_tunnelling_is_reported() {
+    println!(
+        "{:<12} {:>8} {:>10} {:>9}",
+        "resolver", "speed", "wall m", "tunnel/8"
+    );
+    for (name, r) in resolvers() {
+        for speed in [10.0f32, 50.0, 200.0] {
+            for thickness in [0.01f32, 0.05, 0.2] {
+                let n = tunnels(&r, speed, thickness);
+                println!("{name:<12} {speed:>8} {thickness:>10} {n:>9}");
+                if speed * DT < 0.1 + thickness {
+                    // Slower than one ball diameter plus the wall per step: caught without CCD.
+                    assert_eq!(n, 0, "{name}: {speed} m/s through {thickness} m");
+                }
+            }
+        }
+    }
+}
+
+fn tower(resolver: &ResolverChoice, boxes: u32, seconds: f32) -> f32 {
+    let mut w = world(resolver);
+    ground(&mut w, Vec3::ZERO);
+    for i in 0..boxes {
+        w.add_body(cube(
+            &format!("t{i}"),
+            0.5,
+            Vec3::new(0.0, 0.5 + i as f32, 0.0),
+            1000.0,
+        ))
+        .unwrap();
+    }
+    run_checked(&mut w, seconds, 1.0, &format!("tower of {boxes}"))
+}
+
+#[test]
+fn a_20_box_tower_stays_finite() {
+    for (name, r) in resolvers() {
+        let drift = tower(&r, 20, 3.0);
+        println!("{name}: tower of 20, drift from 1 s to 3 s {drift} m");
+    }
+}
+
+#[test]
+#[ignore = "heavy: 100-box towers for 10 s; run with --release --ignored"]
+fn a_100_box_tower_stays_finite() {
+    for (name, r) in resolvers() {
+        let drift = tower(&r, 100, 10.0);
+        println!("{name}: tower of 100, drift from 1 s to 10 s {drift} m");
+    }
+}
+
+/// Total energy (kinetic + gravitational) of the dynamic bodies.
+fn energy(w: &World) -> f64 {
+    let g = w.settings().gravity;
+    w.bodies()
+        .filter(|(_, _, b)| !b.is_fixed())
+        .map(|(_, _, b)| b.kinetic_energy() as f64 - (b.mass() * g.dot(b.position)) as f64)
+        .sum()
+}
+
+fn long_run(resolver: &ResolverChoice, steps: u32) -> (f64, f64) {
+    let mut w = world(resolver);
+    ground(&mut w, Vec3::ZERO);
+    for i in 0..6 {
+        let shape = if i % 2 == 0 {
+            ShapeDesc::Ball { radius: 0.3 }
+        } else {
+            ShapeDesc::Cuboid {
+                half_extents: Vec3::splat(0.3),
+            }
+        };
+        w.add_body(
+            BodyDesc::dynamic(format!("b{i}"), shape)
+                .at(Vec3::new(i as f32 * 0.9 - 2.0, 1.0 + i as f32 * 0.7, 0.0))
+                .rotated(Quat::from_rotation_z(0.3 * i as f32))
+                .moving(Vec3::new(1.0, 0.0, 0.5), Vec3::new(0.0, 2.0, 1.0))
+                .with_material(0.4, 0.5),
+        )
+        .unwrap();
+    }
+    let e0 = energy(&w);
+    let mut worst = e0;
+    for _ in 0..steps {
+        let r = w.step(DT).unwrap();
+        assert!(r.quarantined.is_empty());
+        worst = worst.max(energy(&w));
+    }
+    (e0, worst)
+}
+
+#[test]
+fn energy_stays_bounded_over_a_long_run() {
+    for (name, r) in resolvers() {
+        let (e0, worst) = long_run(&r, 5_000);
+        println!("{name}: 5,000 steps: energy {e0:.2} J at start, at most {worst:.2} J");
+        // No external work: the total energy never rises above its start (1% allowance for the
+        // discrete contact timing of the first impacts).
+        assert!(
+            worst <= e0 * 1.01 + 1e-3,
+            "{name}: energy grew from {e0} to {worst}"
+        );
+    }
+}
+
+#[test]
+#[ignore = "heavy: 100,000 steps; run with --release --ignored"]
+fn energy_stays_bounded_over_100_000_steps() {
+    for (name, r) in resolvers() {
+        let (e0, worst) = long_run(&r, 100_000);
+        println!("{name}: 100,000 steps: energy {e0:.2} J at start, at most {worst:.2} J");
+        assert!(
+            worst <= e0 * 1.01 + 1e-3,
+            "{name}: energy grew from {e0} to {worst}"
+        );
+    }
+}
+
+#[test]
+fn degenerate_shapes_stay_finite_or_are_refused_clearly() {
+    // A perfectly flat hull has no volume: refused with a field-naming error, not a panic.
+    let flat = ShapeDesc::ConvexHull {
+        points: vec![Vec3::ZERO, Vec3::X, Vec3::Z, Vec3::new(1.0, 0.0, 1.0)],
+    };
+    let e = World::new(WorldSettings::default())
+        .add_body(BodyDesc::dynamic("flat", flat))
+        .unwrap_err();
+    assert!(e.to_string().contains("flat"), "{e}");
+    for (name, r) in resolvers() {
+        let mut w = world(&r);
+        // A floor of sliver triangles (1 mm wide, 20 m long).
+        let mut vertices = Vec::new();
+        let mut indices = Vec::new();
+        for i in 0..40u32 {
+            let z = i as f32 * 0.001 - 0.02;
+            vertices.extend([Vec3::new(-10.0, 0.0, z), Vec3::new(10.0, 0.0, z)]);
+            if i > 0 {
+                let (a, b, c, d) = (2 * i - 2, 2 * i - 1, 2 * i, 2 * i + 1);
+                indices.extend([[a, c, b], [b, c, d]]);
+            }
+        }
+        w.add_body(BodyDesc::fixed(
+            "slivers",
+            ShapeDesc::TriMesh { vertices, indices },
+        ))
+        .unwrap();
+        ground(&mut w, Vec3::new(0.0, -1.0, 0.0));
+        // A hull 0.1 mm or 1 mm thick has no usable mass: refused, naming the body and field.
+        let sliver_hull = |h: f32| ShapeDesc::ConvexHull {
+            points: vec![
+                Vec3::ZERO,
+                Vec3::X,
+                Vec3::Z,
+                Vec3::new(1.0, 0.0, 1.0),
+                Vec3::new(0.5, h, 0.5),
+            ],
+        };
+        // parry treats features under ~1 mm on a 1 m hull as coplanar.
+        for h in [1e-4, 1e-3] {
+            let e = w
+                .add_body(BodyDesc::dynamic("sliver", sliver_hull(h)))
+                .unwrap_err();
+            assert!(
+                e.to_string().contains("\"sliver\"") && e.to_string().contains("shape.points"),
+                "{e}"
+            );
+        }
+        // Nearly flat hull (1 cm thick), needle capsule (1 mm radius, 2 m long).
+        let thin = sliver_hull(1e-2);
+        w.add_body(BodyDesc::dynamic("thin hull", thin).at(Vec3::new(2.0, 0.5, 0.0)))
+            .unwrap();
+        w.add_body(
+            BodyDesc::dynamic(
+                "needle",
+                ShapeDesc::Capsule {
+                    half_height: 1.0,
+                    radius: 0.001,
+                },
+            )
+            .at(Vec3::new(-2.0, 1.5, 0.0))
+            .rotated(Quat::from_rotation_z(0.3)),
+        )
+        .unwrap();
+        let ball = w
+            .add_body(
+                BodyDesc::dynamic("ball", ShapeDesc::Ball { radius: 0.2 })
+                    .at(Vec3::new(0.0, 0.5, 0.0)),
+            )
+            .unwrap();
+        run_checked(&mut w, 3.0, 1.0, &format!("{name} degenerate shapes"));
+        let y = w.body(ball).unwrap().position.y;
+        println!("{name}: ball on sliver triangles rests at y = {y}");
+        assert!(
+            y > 0.1,
+            "{name}: the ball fell through the sliver floor (y = {y})"
+        );
+    }
+}
