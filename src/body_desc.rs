@@ -1,6 +1,7 @@
 //! `BodyDesc`: everything needed to add a body with its shape to a world, with documented
 //! defaults, and the errors that name the offending field.
 
+use jostle_body::CcdMode;
 use jostle_collide::{Material, ShapeDesc, ShapeError};
 use jostle_math::{Quat, Vec3};
 use thiserror::Error;
@@ -21,7 +22,7 @@ pub enum MassSpec {
 /// [`BodyDesc::fixed`] and adjust with the builder methods or the public fields.
 ///
 /// Defaults: position at the origin, identity rotation, zero velocities, density 1000 kg/m³,
-/// friction 0.5, restitution 0, damping 0, `can_sleep` true.
+/// friction 0.5, restitution 0, damping 0, `can_sleep` true, `ccd` [`CcdMode::Auto`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct BodyDesc {
     /// Name, used in traces and error messages.
@@ -48,6 +49,9 @@ pub struct BodyDesc {
     pub can_sleep: bool,
     /// Whether the body is immovable.
     pub fixed: bool,
+    /// Continuous collision detection: `Auto` (swept only when fast for its size), `On` or
+    /// `Off`. Ignored for fixed bodies.
+    pub ccd: CcdMode,
 }
 
 impl BodyDesc {
@@ -69,6 +73,7 @@ impl BodyDesc {
             angular_damping: 0.0,
             can_sleep: true,
             fixed: false,
+            ccd: CcdMode::Auto,
         }
     }
 
@@ -108,6 +113,12 @@ impl BodyDesc {
     /// Sets the density (kg/m³).
     pub fn with_density(mut self, density: f32) -> Self {
         self.mass = MassSpec::Density(density);
+        self
+    }
+
+    /// Sets the continuous-collision-detection mode.
+    pub fn with_ccd(mut self, ccd: CcdMode) -> Self {
+        self.ccd = ccd;
         self
     }
 

@@ -24,6 +24,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod bench;
 pub mod body_desc;
 pub mod profile;
 pub mod run;
@@ -36,7 +37,7 @@ pub mod view;
 pub mod world;
 
 pub use body_desc::{BodyDesc, BodyError, MassSpec};
-pub use jostle_body::{BodyHandle, RigidBody};
+pub use jostle_body::{BodyHandle, CcdMode, RigidBody};
 pub use jostle_collide::{
     BodyContact, CollideSettings, CollisionEvent, DisplayMesh, Material, RayHit, ShapeDesc,
 };

@@ -18,6 +18,9 @@ pub struct StepProfile {
     pub gather: Duration,
     /// The resolver (integration included; see `resolve_stats` for its parts).
     pub resolve: Duration,
+    /// Continuous collision detection: the motion test of every awake body and the sweeps of
+    /// the fast ones (between the resolver and the copy back).
+    pub ccd: Duration,
     /// Copying results back, finiteness checks.
     pub scatter: Duration,
     /// Sleep update.
@@ -38,19 +41,28 @@ pub struct StepProfile {
     pub sleeping_bodies: usize,
     /// Islands of touching awake bodies this step.
     pub islands_count: usize,
+    /// Bodies swept by continuous collision detection this step (fast ones, or forced on).
+    pub ccd_bodies: usize,
+    /// Swept bodies stopped at a time of impact this step.
+    pub ccd_hits: usize,
 }
 
 impl StepProfile {
-    /// The stages in pipeline order with their times, for tables.
-    pub fn stages(&self) -> [(&'static str, Duration); 7] {
+    /// The stages in pipeline order with their times, for tables. The `ccd` stage is not listed
+    /// yet (`run.rs` sizes its table for these seven); read [`StepProfile::ccd`].
+    pub fn stages(&self) -> [(&'static str, Duration); Self::STAGES] {
         [
             ("broad", self.broad_phase),
             ("narrow", self.narrow_phase),
             ("islands", self.islands),
             ("gather", self.gather),
             ("resolve", self.resolve),
+            ("ccd", self.ccd),
             ("scatter", self.scatter),
             ("sleep", self.sleep),
         ]
     }
+
+    /// Number of timed stages in [`StepProfile::stages`].
+    pub const STAGES: usize = 8;
 }

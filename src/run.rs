@@ -111,8 +111,9 @@ pub fn run(
         kinetic_energy_initial: world.kinetic_energy(),
         ..Default::default()
     };
-    let mut stage_times: Vec<Vec<Duration>> =
-        (0..7).map(|_| Vec::with_capacity(steps as usize)).collect();
+    let mut stage_times: Vec<Vec<Duration>> = (0..crate::StepProfile::STAGES)
+        .map(|_| Vec::with_capacity(steps as usize))
+        .collect();
     let dynamic = world.bodies().filter(|(_, _, b)| !b.is_fixed()).count();
     for step in 1..=steps {
         let report = world.step(dt)?;

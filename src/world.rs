@@ -10,7 +10,7 @@ use crate::settings::WorldSettings;
 use crate::stages::{self, Scratch};
 use jostle_body::{BodyHandle, BodySet, RigidBody};
 use jostle_collide::{
-    BodyContact, BroadPhase, Collider, ColliderSet, CollisionEvent, NarrowPhase, RayHit,
+    BodyContact, BroadPhase, CcdShape, Collider, ColliderSet, CollisionEvent, NarrowPhase, RayHit,
     mass_properties,
 };
 use jostle_math::{Quat, Vec3};
@@ -62,6 +62,9 @@ pub struct World {
     pub(crate) islands: IslandSet,
     resolver: Box<dyn Resolver>,
     profile: StepProfile,
+    /// Thickness and extent of every collider, by slot, for CCD's motion test; filled for new
+    /// colliders (added bodies, restored snapshots) at the next step.
+    ccd_shapes: Vec<CcdShape>,
     pub(crate) time: f64,
     pub(crate) steps: u64,
     scratch: Scratch,
@@ -83,6 +86,7 @@ impl World {
             islands: IslandSet::new(),
             resolver,
             profile: StepProfile::default(),
+            ccd_shapes: Vec::new(),
             time: 0.0,
             steps: 0,
             scratch: Scratch::default(),
@@ -146,6 +150,7 @@ impl World {
         body.angular_damping = desc.angular_damping;
         body.sleep.can_sleep = desc.can_sleep;
         body.sleep.motion = 2.0 * self.settings.sleep.threshold;
+        body.ccd = desc.ccd;
         let handle = self.bodies.insert(body);
         let collider = self.colliders.insert(Collider {
             shape,
@@ -402,8 +407,10 @@ impl World {
     /// 4. gather — awake bodies into the dense solver array (forces and damping applied),
     ///    contacts into solver contacts; bodies with non-finite state are quarantined here;
     /// 5. resolve — the resolver resolves contacts and integrates;
-    /// 6. scatter — results back to the bodies, impulses back to the manifolds, quarantine;
-    /// 7. sleep — motion averages, islands, resting islands go to sleep.
+    /// 6. ccd — bodies fast for their size are swept from their start pose to their new one
+    ///    against resting geometry and, on a hit, moved back to the time of impact;
+    /// 7. scatter — results back to the bodies, impulses back to the manifolds, quarantine;
+    /// 8. sleep — motion averages, islands, resting islands go to sleep.
     pub fn step(&mut self, dt: f32) -> Result<StepReport, StepError> {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(StepError::InvalidDt(dt));
@@ -448,6 +455,20 @@ impl World {
         p.resolve = t.elapsed();
 
         let t = Instant::now();
+        self.sync_ccd_shapes();
+        stages::ccd(
+            &self.bodies,
+            &self.colliders,
+            &self.ccd_shapes,
+            &self.broad,
+            &self.settings.collide.ccd,
+            dt,
+            &mut self.scratch,
+            &mut p,
+        );
+        p.ccd = t.elapsed();
+
+        let t = Instant::now();
         stages::scatter(
             &mut self.bodies,
             &mut self.narrow,
@@ -474,6 +495,21 @@ impl World {
         self.time += dt as f64;
         self.steps += 1;
         Ok(report)
+    }
+
+    /// Computes the CCD data of colliders added since the last step (colliders are never
+    /// removed, so slots only grow).
+    fn sync_ccd_shapes(&mut self) {
+        for i in self.ccd_shapes.len()..self.colliders.capacity_index() {
+            let shape = self.colliders.by_index(i as u32).map_or(
+                CcdShape {
+                    thickness: f32::INFINITY,
+                    extent: 0.0,
+                },
+                |(_, c)| CcdShape::of(c),
+            );
+            self.ccd_shapes.push(shape);
+        }
     }
 
     /// Broad and narrow phase, accumulated into the profile.

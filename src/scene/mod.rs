@@ -18,7 +18,7 @@
 //! (0, −9.81, 0), `dt` 1/60 s, `steps` 600, `resolver` the engine's best, `sleep` enabled with
 //! threshold 0.3; body `name` "", `position` origin, `rotation` identity (x, y, z, w), zero
 //! velocities, `density` 1000 kg/m³ unless `mass` (kg) is given, `friction` 0.5,
-//! `restitution` 0, damping 0, `can_sleep` true, `fixed` false. `generators` add many bodies
+//! `restitution` 0, damping 0, `can_sleep` true, `fixed` false, `ccd` Auto. `generators` add many bodies
 //! from a few parameters (pyramids, stacks, walls, grids of piles). An optional `camera`
 //! ([`Camera`]) fixes the view of renderers; without one they frame the scene themselves.
 //!
@@ -194,6 +194,9 @@ pub struct BodySpec {
     /// Whether the body is immovable. Default false.
     #[serde(default)]
     pub fixed: bool,
+    /// Continuous collision detection: `Auto`, `On` or `Off`. Default `Auto`.
+    #[serde(default)]
+    pub ccd: jostle_body::CcdMode,
 }
 
 fn identity() -> Quat {
@@ -231,6 +234,7 @@ impl BodySpec {
             angular_damping: self.angular_damping,
             can_sleep: self.can_sleep,
             fixed: self.fixed,
+            ccd: self.ccd,
         };
         desc.validate()?;
         Ok(desc)

@@ -1,9 +1,11 @@
 //! The `jostle` command: runs a scene headless with a progress bar, prints a summary table or
-//! one JSON object, can write a per-step CSV trace, and can render the run to a PNG or GIF.
+//! one JSON object, can write a per-step CSV trace, and can render the run to a PNG or GIF;
+//! `jostle bench` sweeps resolvers and settings over scenes and writes cost against error.
 //!
 //! It is a thin shell over the facade: scene loading, the run loop and the trace format live
 //! in `jostle` itself (`jostle::scene`, `jostle::run`), so tests and benches use the same code.
 
+mod bench_cmd;
 mod render_out;
 mod run_cmd;
 
@@ -22,12 +24,15 @@ struct Cli {
 enum Command {
     /// Run a scene headless and print a summary.
     Run(run_cmd::RunArgs),
+    /// Run scenes under each resolver and sweep setting; write run time against error.
+    Bench(bench_cmd::BenchArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => run_cmd::run(args),
+        Command::Bench(args) => bench_cmd::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

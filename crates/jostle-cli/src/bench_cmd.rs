@@ -1,0 +1,380 @@
+//! `jostle bench`: runs each scene under each resolver and each setting of a sweep, prints a
+//! table of cost against error, and writes `results.csv` and one frontier plot per scene
+//! (error against ms per 1/60 s step, one curve per resolver) as SVG and PNG.
+//!
+//! The measuring is `jostle::bench::run_case`; this file only loops, prints and draws. Plots are
+//! drawn with plotters; text uses the DejaVu Sans bytes of the `dejavu` crate through plotters'
+//! ab_glyph renderer, so it works headless with no system fonts.
+
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use jostle::ResolverChoice;
+use jostle::bench::{Metrics, Setting, Sweep, run_case};
+use jostle::run::{Overrides, load};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The scenes benchmarked when none are named: the stacking set, relative to the working
+/// directory (the repository root).
+const DEFAULT_SCENES: [&str; 3] = [
+    "assets/pyramid_20.ron",
+    "assets/stack_15.ron",
+    "assets/pyramid_heavy_top.ron",
+];
+
+/// The CSV header of `results.csv`, exactly. Empty fields are metrics that do not apply
+/// (energy error of an open system, time to sleep of a scene that never sleeps).
+pub const CSV_HEADER: &str = "scene,resolver,setting,dt,frames,ms_per_step,ms_per_60hz_step,drift_m,max_penetration_m,mean_penetration_m,energy_error,time_to_sleep_s";
+
+/// Arguments of `jostle bench`.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Scene files (.ron). Default: the stacking scenes in ./assets.
+    scenes: Vec<PathBuf>,
+    /// Resolver to run (repeatable): millington, soft-step. Default: both.
+    #[arg(long = "resolver", value_name = "NAME")]
+    resolvers: Vec<String>,
+    /// Vary one setting: iterations, substeps or dt. Default: each scene's own settings only.
+    #[arg(long)]
+    sweep: Option<String>,
+    /// Output directory for results.csv and the plots (created if missing).
+    #[arg(long, default_value = "bench-out", value_name = "DIR")]
+    out: PathBuf,
+    /// Simulated time per run (s). Default: the scene's steps × dt.
+    #[arg(long, value_name = "SECONDS")]
+    duration: Option<f64>,
+    /// Measure drift and penetration from this time on (s); at most half the duration.
+    #[arg(long, default_value_t = 2.0, value_name = "SECONDS")]
+    settle: f64,
+    /// Disable sleeping (every body simulated every step).
+    #[arg(long)]
+    no_sleep: bool,
+}
+
+/// One row of the results.
+struct Row {
+    scene: String,
+    resolver: &'static str,
+    setting: Setting,
+    metrics: Metrics,
+}
+
+pub fn run(args: BenchArgs) -> Result<(), String> {
+    let scenes: Vec<PathBuf> = if args.scenes.is_empty() {
+        DEFAULT_SCENES.iter().map(PathBuf::from).collect()
+    } else {
+        args.scenes.clone()
+    };
+    let resolvers: Vec<ResolverChoice> = if args.resolvers.is_empty() {
+        ResolverChoice::NAMES
+            .iter()
+            .map(|n| ResolverChoice::from_name(n))
+            .collect::<Result<_, _>>()?
+    } else {
+        args.resolvers
+            .iter()
+            .map(|n| ResolverChoice::from_name(n))
+            .collect::<Result<_, _>>()?
+    };
+    let sweep = args.sweep.as_deref().map(Sweep::from_name).transpose()?;
+    if let Some(d) = args.duration
+        && !(d.is_finite() && d > 0.0)
+    {
+        return Err(format!("--duration must be finite and > 0, got {d}"));
+    }
+    if !(args.settle.is_finite() && args.settle >= 0.0) {
+        return Err(format!(
+            "--settle must be finite and >= 0, got {}",
+            args.settle
+        ));
+    }
+
+    // Every case up front, so the progress bar knows the total and bad files fail early.
+    struct Case {
+        path: PathBuf,
+        scene: String,
+        setting: Setting,
+        duration: f64,
+    }
+    let mut cases = Vec::new();
+    for path in &scenes {
+        let probe = load(path, &Overrides::default()).map_err(|e| e.to_string())?;
+        let duration = args
+            .duration
+            .unwrap_or(probe.steps as f64 * probe.dt as f64);
+        for resolver in &resolvers {
+            let settings = match sweep {
+                Some(s) => s.settings(resolver, probe.dt),
+                None => vec![Setting {
+                    label: "default".into(),
+                    resolver: resolver.clone(),
+                    dt: probe.dt,
+                    world_substeps: 1,
+                }],
+            };
+            for setting in settings {
+                cases.push(Case {
+                    path: path.clone(),
+                    scene: probe.name.clone(),
+                    setting,
+                    duration,
+                });
+            }
+        }
+    }
+
+    let bar = ProgressBar::new(cases.len() as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {elapsed} {msg}")
+            .map_err(|e| e.to_string())?,
+    );
+    let mut rows = Vec::new();
+    for case in cases {
+        bar.set_message(format!(
+            "{} / {} / {}",
+            case.scene,
+            case.setting.resolver.name(),
+            case.setting.label
+        ));
+        let overrides = Overrides {
+            resolver: Some(case.setting.resolver.clone()),
+            sleep: args.no_sleep.then_some(false),
+        };
+        let mut setup = load(&case.path, &overrides).map_err(|e| e.to_string())?;
+        let settle = args.settle.min(case.duration / 2.0);
+        let metrics = run_case(&mut setup.world, &case.setting, case.duration, settle)
+            .map_err(|e| format!("{}: {e}", case.path.display()))?;
+        rows.push(Row {
+            scene: case.scene,
+            resolver: case.setting.resolver.name(),
+            setting: case.setting,
+            metrics,
+        });
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    print!("{}", table(&rows));
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("{}: cannot create: {e}", args.out.display()))?;
+    let csv_path = args.out.join("results.csv");
+    std::fs::write(&csv_path, csv(&rows))
+        .map_err(|e| format!("{}: cannot write: {e}", csv_path.display()))?;
+    let mut written = vec![csv_path];
+    let mut names: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
+    names.dedup();
+    for name in names {
+        let scene_rows: Vec<&Row> = rows.iter().filter(|r| r.scene == name).collect();
+        written.extend(plot_scene(&args.out, name, &scene_rows)?);
+    }
+    for p in written {
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+/// An optional metric as a CSV field: empty when it does not apply.
+fn opt(x: Option<f64>, fmt: fn(f64) -> String) -> String {
+    x.map_or(String::new(), fmt)
+}
+
+fn csv(rows: &[Row]) -> String {
+    let mut out = format!("{CSV_HEADER}\n");
+    for r in rows {
+        let m = &r.metrics;
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},{:.6},{:.6},{:e},{:e},{:e},{},{}",
+            r.scene.replace(',', ";"),
+            r.resolver,
+            r.setting.label,
+            r.setting.dt,
+            m.frames,
+            m.ms_per_step,
+            m.ms_per_60hz_step,
+            m.drift,
+            m.max_penetration,
+            m.mean_penetration,
+            opt(m.energy_error, |v| format!("{v:e}")),
+            opt(m.time_to_sleep, |v| format!("{v:.4}")),
+        );
+    }
+    out
+}
+
+fn table(rows: &[Row]) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{:<22} {:<10} {:<14} {:>9} {:>11} {:>10} {:>10} {:>10} {:>10} {:>8}",
+        "scene",
+        "resolver",
+        "setting",
+        "ms/step",
+        "ms/60Hz st",
+        "drift m",
+        "max pen m",
+        "mean pen m",
+        "energy err",
+        "sleep s"
+    );
+    let dash = |x: Option<f64>, prec: usize| x.map_or("-".to_string(), |v| format!("{v:.prec$}"));
+    for r in rows {
+        let m = &r.metrics;
+        let _ = writeln!(
+            out,
+            "{:<22} {:<10} {:<14} {:>9.3} {:>11.3} {:>10.2e} {:>10.2e} {:>10.2e} {:>10} {:>8}",
+            r.scene,
+            r.resolver,
+            r.setting.label,
+            m.ms_per_step,
+            m.ms_per_60hz_step,
+            m.drift,
+            m.max_penetration,
+            m.mean_penetration,
+            m.energy_error.map_or("-".into(), |e| format!("{e:.2e}")),
+            dash(m.time_to_sleep, 2),
+        );
+    }
+    out
+}
+
+/// A file-name-safe form of a scene name ("pyramid 20" → "pyramid_20").
+fn slug(name: &str) -> String {
+    name.chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect()
+}
+
+/// What a scene's plot shows on its y axis: the energy error of a closed system, else drift.
+fn error_of(m: &Metrics, closed: bool) -> f64 {
+    if closed {
+        m.energy_error.unwrap_or(0.0)
+    } else {
+        m.drift as f64
+    }
+}
+
+/// Errors and costs are drawn on log axes; exact zeros are drawn at this floor.
+const FLOOR: f64 = 1e-7;
+
+/// Writes `<out>/<slug>.svg` and `.png`: the scene's error against ms per 1/60 s step, one
+/// curve per resolver, points in sweep order.
+fn plot_scene(out: &Path, name: &str, rows: &[&Row]) -> Result<Vec<PathBuf>, String> {
+    register_font();
+    let closed = rows.iter().all(|r| r.metrics.energy_error.is_some());
+    let base = out.join(slug(name));
+    let svg = base.with_extension("svg");
+    let png = base.with_extension("png");
+    const SIZE: (u32, u32) = (800, 560);
+    draw(
+        SVGBackend::new(&svg, SIZE).into_drawing_area(),
+        name,
+        rows,
+        closed,
+    )?;
+    let mut buf = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    draw(
+        BitMapBackend::with_buffer(&mut buf, SIZE).into_drawing_area(),
+        name,
+        rows,
+        closed,
+    )?;
+    image::save_buffer(&png, &buf, SIZE.0, SIZE.1, image::ExtendedColorType::Rgb8)
+        .map_err(|e| format!("{}: cannot write: {e}", png.display()))?;
+    Ok(vec![svg, png])
+}
+
+fn register_font() {
+    // Registering twice is harmless (the later registration replaces the earlier).
+    let _ =
+        plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
+}
+
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    name: &str,
+    rows: &[&Row],
+    closed: bool,
+) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plot of {name}: {e}");
+    root.fill(&WHITE).map_err(err)?;
+    // Costs span orders of magnitude between resolvers, so both axes are logarithmic.
+    let xs = rows.iter().map(|r| r.metrics.ms_per_60hz_step.max(FLOOR));
+    let ys = rows.iter().map(|r| error_of(&r.metrics, closed).max(FLOOR));
+    let (x_min, x_max) = xs.fold((f64::MAX, 0.0f64), |(lo, hi), x| (lo.min(x), hi.max(x)));
+    // Room on the right for the legend, clear of every point.
+    let (x_min, x_max) = (x_min / 1.5, (x_max * 6.0).max(x_min * 40.0));
+    let (y_min, y_max) = ys.fold((f64::MAX, 0.0f64), |(lo, hi), y| (lo.min(y), hi.max(y)));
+    let (y_min, y_max) = (y_min / 2.0, (y_max * 2.0).max(y_min * 10.0));
+    let metric = if closed {
+        "relative energy error"
+    } else {
+        "drift (m)"
+    };
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("{name}: {metric} against cost"), ("sans-serif", 22))
+        .margin(16)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d((x_min..x_max).log_scale(), (y_min..y_max).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("ms per 1/60 s of simulated time (median)")
+        .y_desc(metric)
+        .x_label_formatter(&|x| format!("{x:.2}"))
+        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    let mut resolvers: Vec<&str> = rows.iter().map(|r| r.resolver).collect();
+    resolvers.dedup();
+    for (i, resolver) in resolvers.into_iter().enumerate() {
+        let color = Palette99::pick(i).to_rgba();
+        let points: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| r.resolver == resolver)
+            .map(|r| {
+                (
+                    r.metrics.ms_per_60hz_step.max(FLOOR),
+                    error_of(&r.metrics, closed).max(FLOOR),
+                )
+            })
+            .collect();
+        chart
+            .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
+            .map_err(err)?
+            .label(resolver)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+        chart
+            .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
+            .map_err(err)?;
+        // Each point is labelled with its setting, so a curve reads as its sweep.
+        let labels = rows
+            .iter()
+            .filter(|r| r.resolver == resolver)
+            .zip(&points)
+            .map(|(r, &p)| {
+                EmptyElement::at(p)
+                    + Text::new(
+                        r.setting.label.clone(),
+                        (6, -14),
+                        ("sans-serif", 11).into_font().color(&color),
+                    )
+            });
+        chart.draw_series(labels).map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::MiddleRight)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}

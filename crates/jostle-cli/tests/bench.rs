@@ -1,0 +1,107 @@
+//! `jostle bench` end to end on tiny scenes: the CSV's columns, finite metrics, both plots.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn temp_dir() -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("jostle-bench-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+const HEADER: [&str; 12] = [
+    "scene",
+    "resolver",
+    "setting",
+    "dt",
+    "frames",
+    "ms_per_step",
+    "ms_per_60hz_step",
+    "drift_m",
+    "max_penetration_m",
+    "mean_penetration_m",
+    "energy_error",
+    "time_to_sleep_s",
+];
+
+#[test]
+fn bench_writes_csv_with_finite_metrics_and_both_plots() {
+    let dir = temp_dir();
+    // A box resting on the ground (it falls asleep: time to sleep), and a box spinning in
+    // zero gravity (a closed system: energy error).
+    let rest = dir.join("rest.ron");
+    std::fs::write(
+        &rest,
+        "Scene(name: \"tiny rest\", steps: 120, bodies: [\
+           Body(name: \"ground\", shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true),\
+           Body(name: \"box\", shape: Cuboid(half_extents: (0.5, 0.5, 0.5)), position: (0.0, 0.5, 0.0))])",
+    )
+    .unwrap();
+    let spin = dir.join("spin.ron");
+    std::fs::write(
+        &spin,
+        "Scene(name: \"tiny spin\", steps: 60, gravity: (0.0, 0.0, 0.0), bodies: [\
+           Body(name: \"box\", shape: Cuboid(half_extents: (0.5, 0.25, 0.1)), angular_velocity: (0.0, 3.0, 0.0), can_sleep: false)])",
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let out = Command::new(env!("CARGO_BIN_EXE_jostle"))
+        .arg("bench")
+        .arg(&rest)
+        .arg(&spin)
+        .args(["--sweep", "substeps", "--settle", "0.5", "--out"])
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("tiny rest") && stdout.contains("soft-step"),
+        "{stdout}"
+    );
+
+    let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next().unwrap().split(',').collect::<Vec<_>>(), HEADER);
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    // 2 scenes × 2 resolvers × 4 substep settings.
+    assert_eq!(rows.len(), 16, "{csv}");
+    let col = |name: &str| HEADER.iter().position(|h| *h == name).unwrap();
+    for row in &rows {
+        assert_eq!(row.len(), HEADER.len(), "{row:?}");
+        let closed = row[0] == "tiny spin";
+        for (i, field) in row.iter().enumerate().skip(3) {
+            // Energy error applies to the closed system only; time to sleep to the resting box.
+            let applies = match HEADER[i] {
+                "energy_error" => closed,
+                "time_to_sleep_s" => !closed,
+                _ => true,
+            };
+            if applies {
+                let x: f64 = field
+                    .parse()
+                    .unwrap_or_else(|e| panic!("{}: `{field}`: {e}", HEADER[i]));
+                assert!(x.is_finite() && x >= 0.0, "{} = {x} in {row:?}", HEADER[i]);
+            } else {
+                assert!(field.is_empty(), "{} = `{field}` in {row:?}", HEADER[i]);
+            }
+        }
+        assert!(row[col("ms_per_step")].parse::<f64>().unwrap() > 0.0);
+    }
+
+    for stem in ["tiny_rest", "tiny_spin"] {
+        for ext in ["svg", "png"] {
+            let p = out_dir.join(format!("{stem}.{ext}"));
+            let len = std::fs::metadata(&p)
+                .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+                .len();
+            assert!(len > 1000, "{} is only {len} bytes", p.display());
+        }
+    }
+    let png = image::open(out_dir.join("tiny_rest.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (800, 560));
+}
