@@ -74,7 +74,7 @@ use crate::{Contact, ResolveStats, Resolver, SolverBody, StepContext};
 use islands::Islands;
 use passes::{PositionPass, VelocityPass};
 use std::time::Instant;
-use worst_first::{Stamps, run_heap, run_linear_scan};
+use worst_first::{Stamps, run_islands};
 
 /// The Millington resolver (see the module docs). Holds its settings and scratch buffers that
 /// are reused from step to step; it keeps no physical state between steps (it does not warm
@@ -140,23 +140,15 @@ impl MillingtonResolver {
             bodies,
             settings,
         };
-        for i in 0..self.islands.len() {
-            let island = self.islands.island(i);
-            let budget = settings.position_iterations.for_contacts(island.len());
-            let eps = settings.position_epsilon;
-            stats.position_iterations += match settings.pick {
-                PickStrategy::Heap => run_heap(
-                    &mut pass,
-                    island,
-                    &self.islands,
-                    &mut self.heap,
-                    &mut self.stamps,
-                    eps,
-                    budget,
-                ),
-                PickStrategy::LinearScan => run_linear_scan(&mut pass, island, eps, budget),
-            };
-        }
+        stats.position_iterations = run_islands(
+            &mut pass,
+            &self.islands,
+            &mut self.heap,
+            &mut self.stamps,
+            settings.pick,
+            &settings.position_iterations,
+            settings.position_epsilon,
+        );
         stats.position_time = start.elapsed();
 
         let start = Instant::now();
@@ -194,23 +186,15 @@ impl MillingtonResolver {
             velocity_epsilon: settings.velocity_epsilon,
             picked: u32::MAX,
         };
-        for i in 0..self.islands.len() {
-            let island = self.islands.island(i);
-            let budget = settings.velocity_iterations.for_contacts(island.len());
-            let eps = settings.velocity_epsilon;
-            stats.velocity_iterations += match settings.pick {
-                PickStrategy::Heap => run_heap(
-                    &mut pass,
-                    island,
-                    &self.islands,
-                    &mut self.heap,
-                    &mut self.stamps,
-                    eps,
-                    budget,
-                ),
-                PickStrategy::LinearScan => run_linear_scan(&mut pass, island, eps, budget),
-            };
-        }
+        stats.velocity_iterations = run_islands(
+            &mut pass,
+            &self.islands,
+            &mut self.heap,
+            &mut self.stamps,
+            settings.pick,
+            &settings.velocity_iterations,
+            settings.velocity_epsilon,
+        );
         for (c, p) in contacts.iter_mut().zip(&self.prepared) {
             c.impulse = p.impulse;
             c.penetration = p.penetration;

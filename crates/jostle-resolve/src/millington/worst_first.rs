@@ -127,3 +127,30 @@ pub(crate) fn run_linear_scan<P: Pass>(
     }
     picks
 }
+
+/// Runs one pass over every island with the chosen pick strategy, each island with its own
+/// budget; returns the picks made.
+pub(crate) fn run_islands<P: Pass>(
+    pass: &mut P,
+    islands: &Islands,
+    heap: &mut IndexedMaxHeap,
+    stamps: &mut Stamps,
+    pick: super::settings::PickStrategy,
+    budget: &super::settings::IterationBudget,
+    epsilon: f32,
+) -> u32 {
+    let mut picks = 0;
+    for i in 0..islands.len() {
+        let island = islands.island(i);
+        let budget = budget.for_contacts(island.len());
+        picks += match pick {
+            super::settings::PickStrategy::Heap => {
+                run_heap(pass, island, islands, heap, stamps, epsilon, budget)
+            }
+            super::settings::PickStrategy::LinearScan => {
+                run_linear_scan(pass, island, epsilon, budget)
+            }
+        };
+    }
+    picks
+}
