@@ -44,7 +44,7 @@ pub fn nonlinear_moves(
     let mut ang = [0.0f32; 2];
     let mut total = 0.0f32;
     for side in 0..2 {
-        if let Some(b) = side_body(p, bodies, side) {
+        if let Some(b) = p.side_body(bodies, side) {
             lin[side] = b.inv_mass;
             ang[side] = angular_inertia(b, p.r[side], n);
             total += lin[side] + ang[side];
@@ -56,7 +56,7 @@ pub fn nonlinear_moves(
     let depth = p.penetration * relaxation;
     let mut moves = PenetrationMoves::default();
     for side in 0..2 {
-        let Some(b) = side_body(p, bodies, side) else {
+        let Some(b) = p.side_body(bodies, side) else {
             continue;
         };
         let sign = if side == 0 { 1.0 } else { -1.0 };
@@ -95,7 +95,7 @@ pub fn linear_moves(
     let depth = p.penetration * relaxation;
     let mut moves = PenetrationMoves::default();
     for side in 0..2 {
-        if let Some(b) = side_body(p, bodies, side) {
+        if let Some(b) = p.side_body(bodies, side) {
             let sign = if side == 0 { 1.0 } else { -1.0 };
             moves.linear[side] = sign * depth * (b.inv_mass / total);
         }
@@ -123,11 +123,7 @@ pub fn apply_moves(
         ..BodyChange::NONE
     };
     for side in 0..2 {
-        let index = p.body[side];
-        let Some(b) = (index != NO_BODY)
-            .then(|| bodies.get_mut(index as usize))
-            .flatten()
-        else {
+        let Some(b) = p.side_body_mut(bodies, side) else {
             change.body[side] = NO_BODY;
             continue;
         };
@@ -188,19 +184,5 @@ pub fn resolvable(p: &PreparedContact, projection: Projection) -> bool {
     match projection {
         Projection::Nonlinear => p.normal_inertia > 0.0,
         Projection::Linear => p.linear_inertia > 0.0,
-    }
-}
-
-#[inline]
-fn side_body<'a>(
-    p: &PreparedContact,
-    bodies: &'a [SolverBody],
-    side: usize,
-) -> Option<&'a SolverBody> {
-    let index = p.body[side];
-    if index == NO_BODY {
-        None
-    } else {
-        bodies.get(index as usize)
     }
 }

@@ -69,6 +69,28 @@ impl PreparedContact {
         self.basis.x_axis
     }
 
+    /// The body on `side` (0 = A, 1 = B), when that side moves.
+    #[inline]
+    pub fn side_body<'a>(&self, bodies: &'a [SolverBody], side: usize) -> Option<&'a SolverBody> {
+        match self.body[side] {
+            NO_BODY => None,
+            index => bodies.get(index as usize),
+        }
+    }
+
+    /// The body on `side`, mutably, when that side moves.
+    #[inline]
+    pub fn side_body_mut<'a>(
+        &self,
+        bodies: &'a mut [SolverBody],
+        side: usize,
+    ) -> Option<&'a mut SolverBody> {
+        match self.body[side] {
+            NO_BODY => None,
+            index => bodies.get_mut(index as usize),
+        }
+    }
+
     /// A contact that takes part in nothing (invalid body indices): zero inertia, no bodies.
     pub fn inert(penetration: f32) -> Self {
         Self {

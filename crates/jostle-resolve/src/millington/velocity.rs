@@ -43,7 +43,7 @@ pub fn impulse_matrix(p: &PreparedContact, bodies: &[SolverBody]) -> Mat3 {
     let mut angular = Mat3::ZERO;
     let mut inv_mass = 0.0;
     for side in 0..2 {
-        let Some(b) = side_body(p, bodies, side) else {
+        let Some(b) = p.side_body(bodies, side) else {
             continue;
         };
         inv_mass += b.inv_mass;
@@ -318,11 +318,7 @@ pub fn apply_impulse(p: &PreparedContact, g: Vec3, bodies: &mut [SolverBody]) ->
         ..BodyChange::NONE
     };
     for side in 0..2 {
-        let index = p.body[side];
-        let Some(b) = (index != NO_BODY)
-            .then(|| bodies.get_mut(index as usize))
-            .flatten()
-        else {
+        let Some(b) = p.side_body_mut(bodies, side) else {
             change.body[side] = NO_BODY;
             continue;
         };
@@ -403,20 +399,5 @@ pub fn reopen_friction(p: &mut PreparedContact, picked: bool, velocity_epsilon: 
         p.saturated_sliding = sliding;
     } else if (sliding - p.saturated_sliding).length() > velocity_epsilon {
         p.friction_saturated = false;
-    }
-}
-
-/// The body of `side`, when that side moves.
-#[inline]
-fn side_body<'a>(
-    p: &PreparedContact,
-    bodies: &'a [SolverBody],
-    side: usize,
-) -> Option<&'a SolverBody> {
-    let index = p.body[side];
-    if index == NO_BODY {
-        None
-    } else {
-        bodies.get(index as usize)
     }
 }
