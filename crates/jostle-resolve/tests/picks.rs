@@ -1,9 +1,10 @@
 //! The worst-first pick: heap and linear scan agree bit for bit, ties go to the lower contact
-//! index, and a resolution updates its neighbours' penetrations as geometry says it should.
+//! index, a resolution updates its neighbours' penetrations as geometry says it should, and
+//! the work of a heap pick grows no faster than log n (counted, not timed).
 
 use jostle_math::{Quat, Vec3};
 use jostle_resolve::millington::{
-    IterationBudget, MillingtonResolver, MillingtonSettings, PickStrategy, Projection,
+    IterationBudget, MillingtonResolver, MillingtonSettings, PickStrategy, PickWork, Projection,
 };
 use jostle_resolve::synthetic::{self, DT, GRAVITY, SyntheticScene, box_body};
 use jostle_resolve::{Contact, ResolveStats, Resolver, STATIC_BODY, SolverBody, StepContext};
@@ -298,4 +299,83 @@ fn static_body_does_not_make_contacts_adjacent() {
         contacts.iter().all(|c| c.penetration.abs() < 1e-6),
         "{contacts:?}"
     );
+}
+
+/// One heap step of `scene`: the work of each pass and the largest island and body degree.
+fn heap_work(scene: &SyntheticScene) -> ([PickWork; 2], usize, usize) {
+    let mut bodies = scene.bodies.clone();
+    let mut contacts = scene.contacts.clone();
+    let mut resolver = MillingtonResolver::new(MillingtonSettings::default());
+    let ctx = StepContext {
+        gravity: GRAVITY,
+        dt: DT,
+    };
+    resolver.step(&mut bodies, &mut contacts, &ctx);
+    let islands = resolver.islands();
+    let largest = (0..islands.len())
+        .map(|i| islands.island(i).len())
+        .max()
+        .unwrap_or(0);
+    let degree = (0..bodies.len() as u32)
+        .map(|b| islands.contacts_of(b).len())
+        .max()
+        .unwrap_or(0);
+    (resolver.last_work(), largest, degree)
+}
+
+/// Issue 4's criterion, on the work a pick does rather than its time (which the bench
+/// measures): per pass, the contacts re-keyed plus the heap entries moved per pick may grow at
+/// most like log n from 256 to 4,096 contacts, and the re-keyed contacts per pick are bounded by
+/// the degree of the two changed bodies, whatever the size. The random pile's largest island
+/// grows with n (one connected pile), so its heap deepens; the stacks' islands do not.
+#[test]
+fn heap_pick_work_grows_no_faster_than_log_n() {
+    let (small, large) = (256usize, 4096usize);
+    let bound = (large as f64).log2() / (small as f64).log2();
+    for family in ["stacks", "random_pile"] {
+        let scene = |n| match family {
+            "stacks" => synthetic::stacks(n, 8, 1),
+            _ => synthetic::random_pile(n, 2),
+        };
+        let (w_small, _, _) = heap_work(&scene(small));
+        let (w_large, largest, degree) = heap_work(&scene(large));
+        if family == "random_pile" {
+            assert!(largest > large / 2, "the pile must form one large island");
+        }
+        for pass in 0..2 {
+            let per_pick = |w: &PickWork| (w.updates + w.heap_moves) as f64 / w.picks as f64;
+            let (a, b) = (&w_small[pass], &w_large[pass]);
+            assert!(a.picks > 0 && b.picks > 0);
+            let ratio = per_pick(b) / per_pick(a);
+            assert!(
+                ratio <= bound,
+                "{family}, pass {pass}: work per pick {:.2} -> {:.2} (x{ratio:.2} > x{bound:.2})",
+                per_pick(a),
+                per_pick(b)
+            );
+            assert!(
+                b.updates as f64 / b.picks as f64 <= (2 * degree) as f64,
+                "{family}, pass {pass}: more updates per pick than two bodies' contacts"
+            );
+            assert_eq!(b.updates, b.keys_read);
+        }
+    }
+}
+
+#[test]
+fn linear_scan_reads_the_whole_island_per_pick() {
+    let scene = synthetic::stacks(320, 8, 3);
+    let settings = MillingtonSettings {
+        pick: PickStrategy::LinearScan,
+        ..Default::default()
+    };
+    let mut bodies = scene.bodies.clone();
+    let mut contacts = scene.contacts.clone();
+    let mut resolver = MillingtonResolver::new(settings);
+    resolver.resolve_contacts(&mut bodies, &mut contacts, DT);
+    for w in resolver.last_work() {
+        // Every island is one column of 8 boxes: 32 contacts.
+        assert_eq!(w.keys_read, 32 * w.picks);
+        assert_eq!(w.heap_moves, 0);
+    }
 }

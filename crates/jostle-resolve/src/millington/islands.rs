@@ -29,6 +29,9 @@ pub struct Islands {
     island_of_root: Vec<u32>,
     /// Island of each contact, or `NO_BODY` when it takes part in nothing (scratch).
     island_of_contact: Vec<u32>,
+    /// Contacts per island, then per-island or per-body write cursors (scratch).
+    counts: Vec<u32>,
+    cursor: Vec<u32>,
 }
 
 impl Islands {
@@ -51,7 +54,8 @@ impl Islands {
         self.island_of_root.resize(body_count, NO_BODY);
         self.island_of_contact.clear();
         self.starts.clear();
-        let mut counts: Vec<u32> = Vec::new();
+        let mut counts = std::mem::take(&mut self.counts);
+        counts.clear();
         for c in contacts {
             let any = if c.body[0] != NO_BODY {
                 c.body[0]
@@ -73,17 +77,19 @@ impl Islands {
         }
         // Counting sort, stable, so each island lists its contacts in ascending order.
         self.starts.push(0);
-        for &count in &counts {
+        for &count in counts.iter() {
             let last = *self.starts.last().unwrap_or(&0);
             self.starts.push(last + count);
         }
         let total = *self.starts.last().unwrap_or(&0) as usize;
         self.order.clear();
         self.order.resize(total, 0);
-        let mut cursor: Vec<u32> = self.starts[..counts.len()].to_vec();
+        self.cursor.clear();
+        self.cursor.extend_from_slice(&self.starts[..counts.len()]);
+        self.counts = counts;
         for (i, &island) in self.island_of_contact.iter().enumerate() {
             if island != NO_BODY {
-                let slot = &mut cursor[island as usize];
+                let slot = &mut self.cursor[island as usize];
                 self.order[*slot as usize] = i as u32;
                 *slot += 1;
             }
@@ -113,11 +119,13 @@ impl Islands {
         self.adj_contacts.clear();
         self.adj_contacts
             .resize(self.adj_starts[body_count] as usize, 0);
-        let mut cursor = self.adj_starts[..body_count].to_vec();
+        self.cursor.clear();
+        self.cursor
+            .extend_from_slice(&self.adj_starts[..body_count]);
         for (i, c) in contacts.iter().enumerate() {
             for body in sides(c) {
                 if body != NO_BODY {
-                    let slot = &mut cursor[body as usize];
+                    let slot = &mut self.cursor[body as usize];
                     self.adj_contacts[*slot as usize] = i as u32;
                     *slot += 1;
                 }

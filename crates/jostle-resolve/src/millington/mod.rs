@@ -74,7 +74,8 @@ use crate::{Contact, ResolveStats, Resolver, SolverBody, StepContext};
 use islands::Islands;
 use passes::{PositionPass, VelocityPass};
 use std::time::Instant;
-use worst_first::{Stamps, run_islands};
+pub use worst_first::PickWork;
+use worst_first::{PickScratch, run_islands};
 
 /// The Millington resolver (see the module docs). Holds its settings and scratch buffers that
 /// are reused from step to step; it keeps no physical state between steps (it does not warm
@@ -85,8 +86,9 @@ pub struct MillingtonResolver {
     pub settings: MillingtonSettings,
     prepared: Vec<PreparedContact>,
     islands: Islands,
-    heap: IndexedMaxHeap,
-    stamps: Stamps,
+    scratch: PickScratch,
+    /// Work of the last step's position and velocity passes.
+    work: [PickWork; 2],
     /// Angular velocities before the position pass (scratch, reused between steps).
     spins: Vec<jostle_math::Vec3>,
 }
@@ -104,6 +106,19 @@ impl MillingtonResolver {
     /// final closing velocities, desired velocity changes and penetrations, for diagnostics.
     pub fn prepared(&self) -> &[PreparedContact] {
         &self.prepared
+    }
+
+    /// The islands and body → contacts adjacency of the last step (contact indices as given
+    /// to it), for diagnostics.
+    pub fn islands(&self) -> &Islands {
+        &self.islands
+    }
+
+    /// What the worst-first loops of the last step did, position pass then velocity pass:
+    /// picks, neighbour updates, keys read and heap moves. Deterministic, unlike times, so
+    /// tests and benches can check how the work of a pick grows with the number of contacts.
+    pub fn last_work(&self) -> [PickWork; 2] {
+        self.work
     }
 
     /// Steps 1–4 of the module docs without integration: prepares the contacts, runs the
@@ -127,8 +142,7 @@ impl MillingtonResolver {
                 .unwrap_or_else(|| PreparedContact::inert(c.penetration))
         }));
         self.islands.build(&self.prepared, bodies.len());
-        self.heap.reset(contacts.len());
-        self.stamps.reset(contacts.len());
+        self.scratch.reset(contacts.len());
         stats.islands = self.islands.len() as u32;
         stats.prepare_time = start.elapsed();
 
@@ -143,12 +157,12 @@ impl MillingtonResolver {
         stats.position_iterations = run_islands(
             &mut pass,
             &self.islands,
-            &mut self.heap,
-            &mut self.stamps,
+            &mut self.scratch,
             settings.pick,
             &settings.position_iterations,
             settings.position_epsilon,
         );
+        self.work[0] = std::mem::take(&mut self.scratch.work);
         stats.position_time = start.elapsed();
 
         let start = Instant::now();
@@ -189,12 +203,12 @@ impl MillingtonResolver {
         stats.velocity_iterations = run_islands(
             &mut pass,
             &self.islands,
-            &mut self.heap,
-            &mut self.stamps,
+            &mut self.scratch,
             settings.pick,
             &settings.velocity_iterations,
             settings.velocity_epsilon,
         );
+        self.work[1] = std::mem::take(&mut self.scratch.work);
         for (c, p) in contacts.iter_mut().zip(&self.prepared) {
             c.impulse = p.impulse;
             c.penetration = p.penetration;

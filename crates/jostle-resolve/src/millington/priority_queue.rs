@@ -1,4 +1,4 @@
-//! An indexed binary max-heap: items are dense `u32` ids (contact indices), each with an `f32`
+//! An indexed max-heap: items are dense `u32` ids (contact indices), each with an `f32`
 //! key that can be raised or lowered in O(log n) because the heap keeps every item's position.
 //!
 //! This is what turns Cyclone's O(n) "find the worst contact" rescan into an O(log n) pick
@@ -8,19 +8,48 @@
 //! [`super::PickStrategy::LinearScan`] give bit-identical results. NaN keys are stored as −∞, so
 //! a non-finite contact is never picked and never breaks the heap order.
 //!
+//! The heap is 4-ary and stores each key next to its item: half the depth of a binary heap,
+//! and a sift reads one contiguous array (issue 4's measurement: heap entries moved per pick
+//! on a 16,384-contact random pile fell from 24.5 to 14.1, L1 misses per pick from 10.0 to
+//! 5.9). The shape changes only the work, never which item is on top, since the order is
+//! total.
+//!
 //! It depends on nothing but `std`.
 
 const ABSENT: u32 = u32::MAX;
 
+/// Children per node. A 4-ary heap is half as deep as a binary one, and a node's four
+/// children (8 bytes each) are adjacent, so a level of a sift down reads at most two cache
+/// lines.
+const ARITY: usize = 4;
+
+/// One heap slot: the key stored next to its item, so comparisons along a sift read the heap
+/// array alone (no indirection through a per-item key array).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Entry {
+    key: f32,
+    item: u32,
+}
+
+impl Entry {
+    /// Whether `self` belongs above `other`: larger key, then lower id.
+    #[inline]
+    fn above(self, other: Entry) -> bool {
+        self.key > other.key || (self.key == other.key && self.item < other.item)
+    }
+}
+
 /// Indexed max-heap over item ids `0..capacity` (see the module docs for the order).
 #[derive(Clone, Debug, Default)]
 pub struct IndexedMaxHeap {
-    /// Heap array of item ids; `heap[0]` is the maximum.
-    heap: Vec<u32>,
+    /// Heap array of (key, item); `heap[0]` is the maximum, the children of slot i are
+    /// `ARITY·i + 1 ..= ARITY·i + ARITY`.
+    heap: Vec<Entry>,
     /// Position of each item in `heap`, or `ABSENT`.
     pos: Vec<u32>,
-    /// Key of each item (meaningful only while the item is present).
-    keys: Vec<f32>,
+    /// Entries moved by sifts since the heap was created (a cheap work counter for tests and
+    /// benchmarks: it is what grows with log n).
+    moves: u64,
 }
 
 impl IndexedMaxHeap {
@@ -32,13 +61,12 @@ impl IndexedMaxHeap {
     /// Empties the heap and makes room for ids `0..capacity`. O(capacity) only when growing;
     /// clearing touches just the items that were present.
     pub fn reset(&mut self, capacity: usize) {
-        for &item in &self.heap {
-            self.pos[item as usize] = ABSENT;
+        for e in &self.heap {
+            self.pos[e.item as usize] = ABSENT;
         }
         self.heap.clear();
         if self.pos.len() < capacity {
             self.pos.resize(capacity, ABSENT);
-            self.keys.resize(capacity, f32::NEG_INFINITY);
         }
     }
 
@@ -51,12 +79,16 @@ impl IndexedMaxHeap {
             let i = item as usize;
             debug_assert!(i < self.pos.len(), "heap item {item} beyond capacity");
             debug_assert!(self.pos[i] == ABSENT, "heap item {item} inserted twice");
-            self.keys[i] = sanitize(key(item));
             self.pos[i] = self.heap.len() as u32;
-            self.heap.push(item);
+            self.heap.push(Entry {
+                key: sanitize(key(item)),
+                item,
+            });
         }
-        for i in (0..self.heap.len() / 2).rev() {
-            self.sift_down(i);
+        if self.heap.len() > 1 {
+            for i in (0..=(self.heap.len() - 2) / ARITY).rev() {
+                self.sift_down(i);
+            }
         }
     }
 
@@ -76,14 +108,20 @@ impl IndexedMaxHeap {
     }
 
     /// The maximum item and its key, without removing it.
+    #[inline]
     pub fn peek(&self) -> Option<(u32, f32)> {
-        self.heap
-            .first()
-            .map(|&item| (item, self.keys[item as usize]))
+        self.heap.first().map(|e| (e.item, e.key))
+    }
+
+    /// Entries moved by sift operations since the heap was created: a work counter (each
+    /// move is one level of a sift), for tests and benchmarks.
+    pub fn moves(&self) -> u64 {
+        self.moves
     }
 
     /// Changes the key of a present item and restores the heap order; absent items are
     /// ignored (debug-asserted).
+    #[inline]
     pub fn set_key(&mut self, item: u32, key: f32) {
         let Some(&p) = self.pos.get(item as usize) else {
             debug_assert!(false, "heap item {item} beyond capacity");
@@ -93,73 +131,78 @@ impl IndexedMaxHeap {
             debug_assert!(false, "heap item {item} is not present");
             return;
         }
-        let old = self.keys[item as usize];
+        let p = p as usize;
+        let old = self.heap[p].key;
         let new = sanitize(key);
-        self.keys[item as usize] = new;
+        self.heap[p].key = new;
         if new > old {
-            self.sift_up(p as usize);
+            self.sift_up(p);
         } else if new < old {
-            self.sift_down(p as usize);
+            self.sift_down(p);
         }
     }
 
-    /// Whether item `a` belongs above item `b`: larger key, then lower id.
     #[inline]
-    fn above(&self, a: u32, b: u32) -> bool {
-        let (ka, kb) = (self.keys[a as usize], self.keys[b as usize]);
-        ka > kb || (ka == kb && a < b)
-    }
-
-    #[inline]
-    fn place(&mut self, i: usize, item: u32) {
-        self.heap[i] = item;
-        self.pos[item as usize] = i as u32;
+    fn place(&mut self, i: usize, e: Entry) {
+        self.heap[i] = e;
+        self.pos[e.item as usize] = i as u32;
     }
 
     fn sift_up(&mut self, mut i: usize) {
-        let item = self.heap[i];
+        let e = self.heap[i];
+        let start = i;
         while i > 0 {
-            let parent = (i - 1) / 2;
+            let parent = (i - 1) / ARITY;
             let p = self.heap[parent];
-            if !self.above(item, p) {
+            if !e.above(p) {
                 break;
             }
             self.place(i, p);
+            self.moves += 1;
             i = parent;
         }
-        self.place(i, item);
+        if i != start {
+            self.place(i, e);
+        }
     }
 
     fn sift_down(&mut self, mut i: usize) {
         let n = self.heap.len();
-        let item = self.heap[i];
+        let e = self.heap[i];
+        let start = i;
         loop {
-            let left = 2 * i + 1;
-            if left >= n {
+            let first = ARITY * i + 1;
+            if first >= n {
                 break;
             }
-            let right = left + 1;
-            let mut child = left;
-            if right < n && self.above(self.heap[right], self.heap[left]) {
-                child = right;
+            let mut child = first;
+            let mut best = self.heap[first];
+            for c in first + 1..(first + ARITY).min(n) {
+                let candidate = self.heap[c];
+                if candidate.above(best) {
+                    child = c;
+                    best = candidate;
+                }
             }
-            let c = self.heap[child];
-            if !self.above(c, item) {
+            if !best.above(e) {
                 break;
             }
-            self.place(i, c);
+            self.place(i, best);
+            self.moves += 1;
             i = child;
         }
-        self.place(i, item);
+        if i != start {
+            self.place(i, e);
+        }
     }
 
     /// Checks the heap order and the position index (tests and debug builds).
     #[cfg(test)]
     fn is_valid(&self) -> bool {
         (0..self.heap.len()).all(|i| {
-            let item = self.heap[i];
-            let parent_ok = i == 0 || !self.above(item, self.heap[(i - 1) / 2]);
-            parent_ok && self.pos[item as usize] == i as u32
+            let e = self.heap[i];
+            let parent_ok = i == 0 || !e.above(self.heap[(i - 1) / ARITY]);
+            parent_ok && self.pos[e.item as usize] == i as u32
         })
     }
 }

@@ -14,6 +14,34 @@ use super::change::BodyChange;
 use super::islands::Islands;
 use super::priority_queue::IndexedMaxHeap;
 
+/// What the worst-first loops did, counted as they run (a few integer additions per pick, so
+/// always on): the evidence that a heap pick costs O(degree · log n) and a rescan O(n),
+/// without timing anything. Summed over both passes of a step by
+/// [`super::MillingtonResolver::last_work`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PickWork {
+    /// Picks made.
+    pub picks: u64,
+    /// Contacts updated after picks: with the heap, each contact sharing a changed body, once
+    /// per pick; with the linear scan, every contact of the island per pick.
+    pub updates: u64,
+    /// Contacts whose key was read to choose a pick: with the heap, the updated contacts
+    /// (re-keyed); with the linear scan, every contact of the island per pick.
+    pub keys_read: u64,
+    /// Heap entries moved by sifts during picks (the initial heapify of each island, O(n),
+    /// is not counted); zero for the linear scan.
+    pub heap_moves: u64,
+}
+
+impl std::ops::AddAssign for PickWork {
+    fn add_assign(&mut self, other: Self) {
+        self.picks += other.picks;
+        self.updates += other.updates;
+        self.keys_read += other.keys_read;
+        self.heap_moves += other.heap_moves;
+    }
+}
+
 /// One pass (position or velocity) as the worst-first loop drives it.
 pub(crate) trait Pass {
     /// The contact's badness: penetration or desired velocity change; −∞ (or NaN) when the
@@ -58,18 +86,38 @@ impl Stamps {
     }
 }
 
+/// The worst-first loops' reusable state: the heap, the update marks and the work counters.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct PickScratch {
+    pub(crate) heap: IndexedMaxHeap,
+    pub(crate) stamps: Stamps,
+    pub(crate) work: PickWork,
+}
+
+impl PickScratch {
+    /// Prepares for a step over `contacts` contacts: empties the heap, clears the marks and
+    /// the counters.
+    pub(crate) fn reset(&mut self, contacts: usize) {
+        self.heap.reset(contacts);
+        self.stamps.reset(contacts);
+        self.work = PickWork::default();
+    }
+}
+
 /// Worst-first over one island with the indexed heap. Returns the number of picks made.
 pub(crate) fn run_heap<P: Pass>(
     pass: &mut P,
     island: &[u32],
     islands: &Islands,
-    heap: &mut IndexedMaxHeap,
-    stamps: &mut Stamps,
+    scratch: &mut PickScratch,
     epsilon: f32,
     budget: u32,
 ) -> u32 {
+    let PickScratch { heap, stamps, work } = scratch;
     heap.build(island, |c| pass.key(c));
+    let moves_before = heap.moves();
     let mut picks = 0;
+    let mut updates = 0;
     while picks < budget {
         let Some((worst, key)) = heap.peek() else {
             break;
@@ -88,10 +136,17 @@ pub(crate) fn run_heap<P: Pass>(
                 if stamps.mark(c) {
                     pass.update(c, &change);
                     heap.set_key(c, pass.key(c));
+                    updates += 1;
                 }
             }
         }
     }
+    *work += PickWork {
+        picks: u64::from(picks),
+        updates,
+        keys_read: updates,
+        heap_moves: heap.moves() - moves_before,
+    };
     picks
 }
 
@@ -102,6 +157,7 @@ pub(crate) fn run_linear_scan<P: Pass>(
     island: &[u32],
     epsilon: f32,
     budget: u32,
+    work: &mut PickWork,
 ) -> u32 {
     let mut picks = 0;
     while picks < budget {
@@ -125,6 +181,13 @@ pub(crate) fn run_linear_scan<P: Pass>(
             pass.update(c, &change);
         }
     }
+    let scanned = island.len() as u64 * u64::from(picks);
+    *work += PickWork {
+        picks: u64::from(picks),
+        updates: scanned,
+        keys_read: scanned,
+        heap_moves: 0,
+    };
     picks
 }
 
@@ -133,8 +196,7 @@ pub(crate) fn run_linear_scan<P: Pass>(
 pub(crate) fn run_islands<P: Pass>(
     pass: &mut P,
     islands: &Islands,
-    heap: &mut IndexedMaxHeap,
-    stamps: &mut Stamps,
+    scratch: &mut PickScratch,
     pick: super::settings::PickStrategy,
     budget: &super::settings::IterationBudget,
     epsilon: f32,
@@ -145,10 +207,10 @@ pub(crate) fn run_islands<P: Pass>(
         let budget = budget.for_contacts(island.len());
         picks += match pick {
             super::settings::PickStrategy::Heap => {
-                run_heap(pass, island, islands, heap, stamps, epsilon, budget)
+                run_heap(pass, island, islands, scratch, epsilon, budget)
             }
             super::settings::PickStrategy::LinearScan => {
-                run_linear_scan(pass, island, epsilon, budget)
+                run_linear_scan(pass, island, epsilon, budget, &mut scratch.work)
             }
         };
     }
