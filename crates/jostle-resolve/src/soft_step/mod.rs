@@ -3,11 +3,13 @@
 //! "Resolver 2: soft step").
 //!
 //! One step of length dt with n substeps of h = dt/n is a linear pipeline:
-//! 1. [`prepare`](constraint::prepare) every contact once on the step-start poses: anchors,
-//!    basis, effective masses, the angular response to unit impulses, softness (static or
-//!    dynamic stiffness, from [`Softness::new`] at h), the approach velocity, and the previous
-//!    step's impulse as the warm start. Contacts with a gap above the speculative margin, or
-//!    between two immovable bodies, take no part.
+//! 1. [`prepare`](prepare::prepare_point) every contact once on the step-start poses:
+//!    anchors, basis, effective masses, the angular response to unit impulses, softness
+//!    (static or dynamic stiffness, from [`Softness::new`] at h), the approach velocity, and
+//!    the previous step's impulse as the warm start; contacts with a gap above the speculative
+//!    margin, or between two immovable bodies, take no part. The contacts are packed eight
+//!    manifolds to a batch of independent bodies ([`batch`]) and every kernel below works on
+//!    eight manifolds at once ([`lanes`]).
 //! 2. per substep: integrate gravity (and the implicit gyroscopic torque) into velocities;
 //!    warm start (apply the accumulated impulses); solve every contact once with its soft bias,
 //!    the separation recomputed from the bodies' motion since the start of the step;
@@ -20,7 +22,7 @@
 //! Unlike the Millington resolver there is no position projection: overlap is removed by the
 //! soft constraint's bias velocity, which the relax pass then takes back out, so resolving
 //! overlap does not make things bounce. The contacts are solved simultaneously (in a fixed
-//! order, to convergence over the substeps), so a Newton's cradle of touching balls does not
+//! order, colour by colour, to convergence over the substeps), so a Newton's cradle of touching balls does not
 //! give the textbook one-ball-out answer; momentum and energy are still conserved.
 //!
 //! In: solver bodies and contacts. Out: moved bodies, each contact's impulse and remaining
@@ -29,16 +31,19 @@
 // `!(x > 0.0)` is deliberate: it is true for NaN, which must take the "do nothing" branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod batch;
 pub mod body_state;
-pub mod constraint;
 pub mod gyroscopic;
 pub mod integrate;
+pub mod lanes;
+pub mod prepare;
 pub mod settings;
 pub mod softness;
 pub mod solve;
 
+pub use batch::Batches;
 pub use body_state::BodyState;
-pub use constraint::SoftContact;
+pub use prepare::PrepareParams;
 pub use settings::SoftStepSettings;
 pub use softness::Softness;
 
@@ -55,9 +60,10 @@ pub struct SoftStepResolver {
     pub settings: SoftStepSettings,
     states: Vec<BodyState>,
     inertia: Vec<Mat3>,
-    constraints: Vec<SoftContact>,
-    /// For each constraint, the index of its contact in the input.
-    sources: Vec<u32>,
+    /// The prepared contacts packed eight manifolds to a batch for the kernels.
+    batches: Batches,
+    /// Normal impulses before the restitution pass, restored after it.
+    saved_impulse: Vec<lanes::F8>,
 }
 
 impl SoftStepResolver {
@@ -69,9 +75,10 @@ impl SoftStepResolver {
         }
     }
 
-    /// The contacts as the last step solved them (only those that took part), for diagnostics.
-    pub fn constraints(&self) -> &[SoftContact] {
-        &self.constraints
+    /// The contacts of the last step as packed for the kernels (only those that took part),
+    /// with their impulses as the step left them: for diagnostics.
+    pub fn batches(&self) -> &Batches {
+        &self.batches
     }
 
     /// Loads the body states and, with the gyroscopic term on, the step-start inertia tensors.
@@ -111,19 +118,14 @@ impl SoftStepResolver {
         } else {
             0.0
         };
-        self.constraints.clear();
-        self.sources.clear();
-        let mut any_restitution = false;
-        for (i, c) in contacts.iter().enumerate() {
-            if let Some(sc) =
-                constraint::prepare(c, bodies, s.speculative_margin, fixed, dynamic, warm)
-            {
-                any_restitution |= sc.restitution > 0.0;
-                self.constraints.push(sc);
-                self.sources.push(i as u32);
-            }
-        }
-        any_restitution
+        let params = PrepareParams {
+            static_softness: fixed,
+            dynamic_softness: dynamic,
+            warm_scale: warm,
+        };
+        self.batches
+            .pack(contacts, bodies, s.speculative_margin, &params);
+        self.batches.any_restitution
     }
 }
 
@@ -172,8 +174,14 @@ impl Resolver for SoftStepResolver {
             integrate_time += t.elapsed();
 
             let t = Instant::now();
-            solve::warm_start(&mut self.constraints, &mut self.states);
-            solve::solve(&mut self.constraints, &mut self.states, inv_h, push_out);
+            solve::warm_start(&mut self.batches, &mut self.states);
+            solve::solve(
+                &mut self.batches,
+                &mut self.states,
+                inv_h,
+                push_out,
+                self.settings.friction_in_bias_pass || self.settings.relax_iterations == 0,
+            );
             solve_time += t.elapsed();
 
             let t = Instant::now();
@@ -182,24 +190,28 @@ impl Resolver for SoftStepResolver {
 
             let t = Instant::now();
             for _ in 0..self.settings.relax_iterations {
-                solve::relax(&mut self.constraints, &mut self.states, inv_h);
+                solve::relax(&mut self.batches, &mut self.states, inv_h);
             }
             relax_time += t.elapsed();
         }
         let t = Instant::now();
         let threshold = self.settings.restitution_threshold;
-        if any_restitution
-            && self
-                .constraints
-                .iter()
-                .any(|c| solve::bounces(c, threshold))
-        {
+        if any_restitution && solve::any_bounces(&self.batches, threshold) {
+            // The bounce is an impulse of this step only: what the next step warm starts
+            // from is the substeps' impulse, not the impact's (carried over, the impact
+            // passed through a row of touching bodies is re-applied next step as a push).
+            self.saved_impulse.clear();
+            self.saved_impulse
+                .extend(self.batches.points.iter().map(|p| p.normal_impulse));
             for _ in 0..self.settings.restitution_iterations {
                 let correction =
-                    solve::restitution(&mut self.constraints, &mut self.states, threshold, inv_h);
+                    solve::restitution(&mut self.batches, &mut self.states, threshold, inv_h);
                 if !(correction > SoftStepSettings::RESTITUTION_TOLERANCE) {
                     break;
                 }
+            }
+            for (p, &saved) in self.batches.points.iter_mut().zip(&self.saved_impulse) {
+                p.normal_impulse = saved;
             }
         }
         relax_time += t.elapsed();
@@ -208,12 +220,11 @@ impl Resolver for SoftStepResolver {
         for c in contacts.iter_mut() {
             c.impulse = jostle_math::Vec3::ZERO;
         }
-        for (sc, &i) in self.constraints.iter().zip(&self.sources) {
+        solve::results(&self.batches, &self.states, |i, impulse, separation| {
             let c = &mut contacts[i as usize];
-            c.impulse = solve::accumulated(sc) * substeps as f32;
-            let (a, b) = (&self.states[sc.a as usize], &self.states[sc.b as usize]);
-            c.penetration = -sc.separation(a, b);
-        }
+            c.impulse = impulse * substeps as f32;
+            c.penetration = -separation;
+        });
         for (body, state) in bodies.iter_mut().zip(&self.states).skip(1) {
             state.store(body);
             body.last_acceleration = if body.inv_mass > 0.0 {
@@ -227,7 +238,7 @@ impl Resolver for SoftStepResolver {
         // pure velocity work.
         stats.position_time = solve_time;
         stats.velocity_time = relax_time;
-        let n = self.constraints.len() as u32;
+        let n = self.batches.contacts;
         stats.position_iterations = n.saturating_mul(substeps);
         stats.velocity_iterations = n.saturating_mul(substeps * self.settings.relax_iterations);
         stats

@@ -51,6 +51,13 @@ pub struct SoftStepSettings {
     /// true. Without it a free body's angular momentum is not conserved when its inertia is
     /// not spherical (a spun box never flips about its intermediate axis).
     pub gyroscopic: bool,
+    /// Solve friction in the biased pass too, not only in the relax pass. Default false: the
+    /// biased pass's push-out velocities are not real motion, and friction reacting to them
+    /// drags resting bodies sideways (a 20-row pyramid drifts 5.3 mm from 2 s to 10 s with
+    /// friction in both passes, 1.1 mm without; rapier3d's `friction_in_bias_pass` default
+    /// is the same). Friction is always solved in the biased pass when `relax_iterations` is
+    /// 0, since there is no other.
+    pub friction_in_bias_pass: bool,
     /// Start each step from the contact impulses of the previous step (matched by feature
     /// id). Default true. Without it stacks need many more substeps to stand.
     pub warm_start: bool,
@@ -69,6 +76,7 @@ impl Default for SoftStepSettings {
             restitution_threshold: 1.0,
             restitution_iterations: 64,
             gyroscopic: true,
+            friction_in_bias_pass: false,
             warm_start: true,
         }
     }

@@ -1,0 +1,443 @@
+//! Packing prepared contacts into eight-lane batches of independent manifolds.
+//!
+//! The soft-step kernels solve eight contact manifolds at once, one per SIMD lane
+//! ([`super::lanes`]). Eight manifolds can share a batch only if no two of them write the same
+//! body, so the manifolds are first coloured (Box2D v3's graph colouring): each non-static
+//! body keeps a 64-bit mask of the colours its manifolds already use, and a manifold takes the
+//! lowest colour free in both of its bodies' masks. Manifolds of one colour touch disjoint
+//! bodies; they are packed eight to a batch in colour order, then input order, so the result is
+//! deterministic. The static entry (index 0) is never written and never coloured. A manifold
+//! that finds all 64 colours taken (a body with more than 64 manifolds) goes to a batch of its
+//! own, solved after the coloured ones.
+//!
+//! Solving colour by colour is still Gauss-Seidel (each batch sees the velocities the previous
+//! batches left), only in a different order than the input's.
+//!
+//! A manifold here is a run of consecutive contacts between the same two bodies, at
+//! most [`MAX_POINTS`] long (the narrow phase emits a manifold's points together; a longer run
+//! is split). Lanes with fewer points than the batch's longest, and lanes without a manifold,
+//! hold zero points: zero normal, zero effective mass, zero friction, bodies at the static
+//! entry, so every impulse they compute is exactly zero.
+
+use super::lanes::{F8, V3x8, WIDTH};
+use super::prepare::{BodyLanes, PrepareParams, prepare_point};
+use crate::{Contact, STATIC_BODY, SolverBody};
+
+/// Manifolds per batch: the lane count of [`super::lanes`].
+pub const LANES: usize = WIDTH;
+
+/// Most contact points per manifold lane.
+pub const MAX_POINTS: usize = 4;
+
+/// Colours available before a manifold overflows into a batch of its own.
+const COLOURS: u32 = 64;
+
+/// Marks a lane-point that holds no contact.
+pub const NO_SOURCE: u32 = u32::MAX;
+
+/// One contact point of each of eight manifolds, stored by lane, as [`prepare_point`] computes
+/// it; a padding lane holds zeros.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)]
+pub struct PointLanes {
+    /// Unit normal from B toward A.
+    pub normal: V3x8,
+    /// Anchor relative to A's centre of mass at the start of the step (m).
+    pub r_a: V3x8,
+    /// Anchor relative to B's centre of mass at the start of the step (m).
+    pub r_b: V3x8,
+    /// I_A⁻¹·(r_A × n).
+    pub ang_a_normal: V3x8,
+    /// I_B⁻¹·(r_B × n).
+    pub ang_b_normal: V3x8,
+    /// Adjusted separation at the start of the step (m).
+    pub base_separation: F8,
+    /// Normal effective mass (kg).
+    pub normal_mass: F8,
+    /// Accumulated normal impulse (N·s).
+    pub normal_impulse: F8,
+    /// Largest normal impulse increment of the step (N·s).
+    pub max_normal_impulse: F8,
+    /// Soft bias rate (1/s).
+    pub bias_rate: F8,
+    /// Soft mass scale.
+    pub mass_scale: F8,
+    /// Soft impulse scale.
+    pub impulse_scale: F8,
+    /// Friction coefficient μ.
+    pub friction: F8,
+    /// First tangent.
+    pub tangent1: V3x8,
+    /// Second tangent.
+    pub tangent2: V3x8,
+    /// I_A⁻¹·(r_A × t₁).
+    pub ang_a_tangent1: V3x8,
+    /// I_A⁻¹·(r_A × t₂).
+    pub ang_a_tangent2: V3x8,
+    /// I_B⁻¹·(r_B × t₁).
+    pub ang_b_tangent1: V3x8,
+    /// I_B⁻¹·(r_B × t₂).
+    pub ang_b_tangent2: V3x8,
+    /// Inverse 2×2 tangent effective mass (symmetric: [0,0], [0,1], [1,1]).
+    pub tangent_mass: [F8; 3],
+    /// Accumulated friction impulse along t₁, t₂ (N·s).
+    pub tangent_impulse: [F8; 2],
+    /// Restitution e.
+    pub restitution: F8,
+    /// Normal relative velocity at the start of the step (m/s).
+    pub relative_velocity: F8,
+}
+
+/// Eight manifolds (one per lane) with disjoint non-static bodies; their points are
+/// `points[first .. first + count]` of the [`Batches`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ManifoldLanes {
+    /// Solver index of body A per lane ([`STATIC_BODY`] for a padding lane).
+    pub a: [u32; LANES],
+    /// Solver index of body B per lane.
+    pub b: [u32; LANES],
+    /// 1/m of A per lane (1/kg).
+    pub inv_mass_a: F8,
+    /// 1/m of B per lane (1/kg).
+    pub inv_mass_b: F8,
+    /// Index of the first [`PointLanes`] of this batch.
+    pub first: u32,
+    /// Number of [`PointLanes`]: the most points of any lane.
+    pub count: u32,
+    /// Whether any point of any lane has friction (μ > 0): otherwise friction is skipped.
+    pub friction: bool,
+}
+
+/// The prepared contacts of one step, packed for the kernels.
+#[derive(Clone, Debug, Default)]
+pub struct Batches {
+    /// The batches, coloured ones first, in colour order.
+    pub manifolds: Vec<ManifoldLanes>,
+    /// The points of all batches.
+    pub points: Vec<PointLanes>,
+    /// For each [`PointLanes`], the input contact index of each lane, or [`NO_SOURCE`].
+    pub sources: Vec<[u32; LANES]>,
+    /// Number of colours used (batches of a colour never share a written body).
+    pub colours: u32,
+    /// Manifolds that found no free colour and were given a batch of their own.
+    pub overflow: u32,
+    /// Contact points packed (lanes holding a contact).
+    pub contacts: u32,
+    /// Whether any packed contact has restitution (e > 0).
+    pub any_restitution: bool,
+    // Scratch reused from step to step.
+    colour_mask: Vec<u64>,
+    runs: Vec<Run>,
+    order: Vec<u32>,
+    /// Input indices of the contacts that take part, in input order.
+    kept: Vec<u32>,
+}
+
+/// A manifold before packing: a run of prepared contacts and its colour.
+#[derive(Clone, Copy, Debug)]
+struct Run {
+    start: u32,
+    len: u32,
+    colour: u32,
+}
+
+impl Run {
+    const EMPTY: Run = Run {
+        start: 0,
+        len: 0,
+        colour: 0,
+    };
+}
+
+impl Batches {
+    /// Prepares and packs the contacts of one step: those with a gap of at most
+    /// `speculative_margin` (m) between two bodies of which at least one can move; the
+    /// others take no part.
+    pub fn pack(
+        &mut self,
+        contacts: &[Contact],
+        bodies: &[SolverBody],
+        speculative_margin: f32,
+        params: &PrepareParams,
+    ) {
+        self.manifolds.clear();
+        self.points.clear();
+        self.sources.clear();
+        self.runs.clear();
+        self.kept.clear();
+        self.colour_mask.clear();
+        self.colour_mask.resize(bodies.len(), 0);
+        self.colours = 0;
+        self.overflow = 0;
+        self.any_restitution = false;
+        for (i, c) in contacts.iter().enumerate() {
+            let (ba, bb) = (&bodies[c.a as usize], &bodies[c.b as usize]);
+            if -c.penetration <= speculative_margin && (ba.is_movable() || bb.is_movable()) {
+                debug_assert_ne!(c.a, c.b, "a contact needs two different bodies");
+                debug_assert!(
+                    (c.normal.length_squared() - 1.0).abs() < 1e-3,
+                    "contact normal must be unit, got {}",
+                    c.normal
+                );
+                self.kept.push(i as u32);
+                self.any_restitution |= c.restitution > 0.0;
+            }
+        }
+        self.contacts = self.kept.len() as u32;
+
+        // Manifolds: runs of the same body pair, coloured by the colour masks.
+        let mut start = 0;
+        let kept = &self.kept;
+        while start < kept.len() {
+            let first = &contacts[kept[start] as usize];
+            let (a, b) = (first.a, first.b);
+            let mut len = 1;
+            while start + len < kept.len() && len < MAX_POINTS && {
+                let c = &contacts[kept[start + len] as usize];
+                c.a == a && c.b == b
+            } {
+                len += 1;
+            }
+            let mask = |i: u32| {
+                if i == STATIC_BODY {
+                    0
+                } else {
+                    self.colour_mask[i as usize]
+                }
+            };
+            let free = !(mask(a) | mask(b));
+            let colour = if free == 0 {
+                COLOURS
+            } else {
+                free.trailing_zeros()
+            };
+            if colour < COLOURS {
+                for i in [a, b] {
+                    if i != STATIC_BODY {
+                        self.colour_mask[i as usize] |= 1 << colour;
+                    }
+                }
+                self.colours = self.colours.max(colour + 1);
+            } else {
+                self.overflow += 1;
+            }
+            self.runs.push(Run {
+                start: start as u32,
+                len: len as u32,
+                colour,
+            });
+            start += len;
+        }
+
+        // Colour order, stable: a counting sort of run indices by colour.
+        let mut counts = [0u32; COLOURS as usize + 2];
+        for r in &self.runs {
+            counts[r.colour as usize + 1] += 1;
+        }
+        for c in 1..counts.len() {
+            counts[c] += counts[c - 1];
+        }
+        self.order.clear();
+        self.order.resize(self.runs.len(), 0);
+        for (i, r) in self.runs.iter().enumerate() {
+            let slot = &mut counts[r.colour as usize];
+            self.order[*slot as usize] = i as u32;
+            *slot += 1;
+        }
+
+        // Pack: eight runs of one colour per batch; an overflow run alone.
+        let mut k = 0;
+        while k < self.order.len() {
+            let colour = self.runs[self.order[k] as usize].colour;
+            let mut lanes = 1;
+            if colour < COLOURS {
+                while lanes < LANES
+                    && k + lanes < self.order.len()
+                    && self.runs[self.order[k + lanes] as usize].colour == colour
+                {
+                    lanes += 1;
+                }
+            }
+            let mut batch_runs = [Run::EMPTY; LANES];
+            for (l, run) in batch_runs.iter_mut().enumerate().take(lanes) {
+                *run = self.runs[self.order[k + l] as usize];
+            }
+            self.push_batch(&batch_runs[..lanes], contacts, bodies, params);
+            k += lanes;
+        }
+    }
+
+    /// Appends one batch holding `runs` (at most [`LANES`]) in lanes 0, 1, ...
+    fn push_batch(
+        &mut self,
+        runs: &[Run],
+        contacts: &[Contact],
+        bodies: &[SolverBody],
+        params: &PrepareParams,
+    ) {
+        debug_assert!(!runs.is_empty() && runs.len() <= LANES);
+        let count = runs.iter().map(|r| r.len).max().unwrap_or(0);
+        let first = self.points.len() as u32;
+        let mut a = [STATIC_BODY; LANES];
+        let mut b = [STATIC_BODY; LANES];
+        for (lane, r) in runs.iter().enumerate() {
+            let c0 = &contacts[self.kept[r.start as usize] as usize];
+            (a[lane], b[lane]) = (c0.a, c0.b);
+        }
+        let (body_a, body_b) = (BodyLanes::gather(bodies, a), BodyLanes::gather(bodies, b));
+        let mut friction = false;
+        for p in 0..count {
+            let mut source = [NO_SOURCE; LANES];
+            let mut lane_contacts: [Option<&Contact>; LANES] = [None; LANES];
+            for (lane, r) in runs.iter().enumerate() {
+                if p < r.len {
+                    let i = self.kept[(r.start + p) as usize];
+                    source[lane] = i;
+                    let c = &contacts[i as usize];
+                    friction |= c.friction > 0.0;
+                    lane_contacts[lane] = Some(c);
+                }
+            }
+            self.points
+                .push(prepare_point(lane_contacts, &body_a, &body_b, params));
+            self.sources.push(source);
+        }
+        self.manifolds.push(ManifoldLanes {
+            a,
+            b,
+            inv_mass_a: body_a.inv_mass,
+            inv_mass_b: body_b.inv_mass,
+            first,
+            count,
+            friction,
+        });
+    }
+
+    /// Every (batch, point) pair with a contact in `lane`, for tests and diagnostics: yields
+    /// (point index, lane, input contact index).
+    pub fn lanes(&self) -> impl Iterator<Item = (usize, usize, u32)> + '_ {
+        self.sources.iter().enumerate().flat_map(|(p, s)| {
+            s.iter()
+                .enumerate()
+                .filter(|(_, src)| **src != NO_SOURCE)
+                .map(move |(lane, src)| (p, lane, *src))
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::soft_step::Softness;
+    use jostle_math::{Mat3, Quat, Vec3};
+
+    fn params() -> PrepareParams {
+        let s = Softness::new(30.0, 10.0, 1.0 / 240.0);
+        PrepareParams {
+            static_softness: s,
+            dynamic_softness: s,
+            warm_scale: 0.25,
+        }
+    }
+
+    fn bodies(n: u32) -> Vec<SolverBody> {
+        let mut bodies = vec![SolverBody::STATIC];
+        for i in 0..n {
+            bodies.push(SolverBody::new(
+                Vec3::new(0.0, i as f32 + 0.5, 0.0),
+                Quat::IDENTITY,
+                1.0,
+                Mat3::IDENTITY,
+            ));
+        }
+        bodies
+    }
+
+    /// A chain of `n` bodies, each touching the next with a `points`-point manifold, the first
+    /// also touching the ground (static entry).
+    fn chain(n: u32, points: usize) -> Vec<Contact> {
+        let mut contacts = Vec::new();
+        for i in 0..n {
+            for p in 0..points {
+                let point = Vec3::new(p as f32 * 0.1, i as f32, 0.0);
+                contacts.push(Contact::new(i + 1, i, point, Vec3::Y, 0.001).with_friction(0.5));
+            }
+        }
+        contacts
+    }
+
+    #[test]
+    fn batches_never_share_a_written_body_and_keep_every_contact_once() {
+        let contacts = chain(21, 4);
+        let mut batches = Batches::default();
+        batches.pack(&contacts, &bodies(21), 0.02, &params());
+        for m in &batches.manifolds {
+            let mut written: Vec<u32> =
+                m.a.iter()
+                    .chain(&m.b)
+                    .copied()
+                    .filter(|&i| i != 0)
+                    .collect();
+            let before = written.len();
+            written.sort_unstable();
+            written.dedup();
+            assert_eq!(written.len(), before, "a body twice in {m:?}");
+        }
+        let mut seen: Vec<u32> = batches.lanes().map(|(_, _, s)| s).collect();
+        seen.sort_unstable();
+        assert_eq!(seen, (0..contacts.len() as u32).collect::<Vec<_>>());
+        // A chain needs two colours; 21 manifolds in 2 colours fill ⌈11/8⌉ + ⌈10/8⌉ batches.
+        assert_eq!(batches.colours, 2);
+        assert_eq!(batches.manifolds.len(), 2 + 2);
+        assert_eq!(batches.overflow, 0);
+    }
+
+    #[test]
+    fn far_and_immovable_contacts_take_no_part() {
+        let mut contacts = chain(2, 1);
+        contacts[1].penetration = -0.5; // gap beyond the margin
+        contacts.push(Contact::new(0, 0, Vec3::ZERO, Vec3::Y, 0.1)); // static against static
+        let mut batches = Batches::default();
+        batches.pack(&contacts, &bodies(2), 0.02, &params());
+        assert_eq!(batches.contacts, 1);
+        assert_eq!(batches.lanes().map(|(_, _, s)| s).collect::<Vec<_>>(), [0]);
+    }
+
+    #[test]
+    fn a_body_with_more_than_64_manifolds_overflows_into_single_batches() {
+        // 70 one-point manifolds all on body 1.
+        let contacts: Vec<Contact> = (2..72)
+            .map(|b| Contact::new(1, b, Vec3::ZERO, Vec3::X, 0.0))
+            .collect();
+        let mut batches = Batches::default();
+        batches.pack(&contacts, &bodies(71), 0.02, &params());
+        assert_eq!(batches.colours, 64);
+        assert_eq!(batches.overflow, 6);
+        assert_eq!(batches.manifolds.len(), 70);
+        assert_eq!(batches.lanes().count(), 70);
+    }
+
+    /// The lane-wise preparation gives what the formulas give for one contact: effective
+    /// mass, angular response, adjusted separation and approach velocity.
+    #[test]
+    fn a_prepared_lane_matches_the_scalar_formulas() {
+        let mut bodies = bodies(1);
+        let inv_i = Mat3::from_diagonal(Vec3::new(2.0, 3.0, 4.0));
+        bodies[1] = SolverBody::new(Vec3::new(0.0, 0.5, 0.0), Quat::IDENTITY, 0.5, inv_i);
+        bodies[1].linear_velocity = Vec3::new(0.0, -1.0, 0.0);
+        let c = Contact::new(1, 0, Vec3::new(0.3, 0.0, -0.2), Vec3::Y, 0.01);
+        let mut batches = Batches::default();
+        batches.pack(&[c], &bodies, 0.02, &params());
+        let p = &batches.points[0];
+        let r = c.point - bodies[1].position;
+        let rn = r.cross(Vec3::Y);
+        let k = 0.5 + rn.dot(inv_i * rn);
+        assert!((p.normal_mass[0] - 1.0 / k).abs() < 1e-6);
+        assert!((p.ang_a_normal.lane(0) - inv_i * rn).length() < 1e-6);
+        assert!((p.base_separation[0] - (-0.01 - r.y)).abs() < 1e-6);
+        assert_eq!(p.relative_velocity[0], -1.0);
+        for lane in 1..LANES {
+            assert_eq!(p.normal_mass[lane], 0.0, "padding lane {lane}");
+        }
+    }
+}
