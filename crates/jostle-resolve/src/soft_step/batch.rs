@@ -286,6 +286,8 @@ impl Batches {
         }
         let (body_a, body_b) = (BodyLanes::gather(bodies, a), BodyLanes::gather(bodies, b));
         let mut friction = false;
+        self.points
+            .resize(first as usize + count as usize, PointLanes::default());
         for p in 0..count {
             let mut source = [NO_SOURCE; LANES];
             let mut lane_contacts: [Option<&Contact>; LANES] = [None; LANES];
@@ -298,8 +300,8 @@ impl Batches {
                     lane_contacts[lane] = Some(c);
                 }
             }
-            self.points
-                .push(prepare_point(lane_contacts, &body_a, &body_b, params));
+            let out = &mut self.points[(first + p) as usize];
+            prepare_point(out, lane_contacts, &body_a, &body_b, params);
             self.sources.push(source);
         }
         self.manifolds.push(ManifoldLanes {

@@ -80,15 +80,16 @@ impl BodyLanes {
     }
 }
 
-/// Prepares one point of eight lanes: `contacts[lane]` between the bodies of lane `lane` in
+/// Prepares one point of eight lanes into `out`: `contacts[lane]` between the bodies of lane `lane` in
 /// `a` and `b`. Lanes whose contact is `None` are padding and get zeros (zero normal, zero
 /// masses), so every impulse they compute is zero.
 pub fn prepare_point(
+    out: &mut PointLanes,
     contacts: [Option<&Contact>; WIDTH],
     a: &BodyLanes,
     b: &BodyLanes,
     params: &PrepareParams,
-) -> PointLanes {
+) {
     let mut n = V3x8::ZERO;
     let mut t1 = V3x8::ZERO;
     let mut t2 = V3x8::ZERO;
@@ -142,7 +143,7 @@ pub fn prepare_point(
     let warm = stored * F8::splat(params.warm_scale);
     let has_friction = friction.cmpgt(F8::ZERO);
     let dv = a.velocity_at(r_a) - b.velocity_at(r_b);
-    PointLanes {
+    *out = PointLanes {
         normal: n,
         r_a,
         r_b,
@@ -169,5 +170,5 @@ pub fn prepare_point(
         ],
         restitution: F8::from_array(restitution),
         relative_velocity: dv.dot(n),
-    }
+    };
 }
