@@ -19,6 +19,11 @@
 //!   with the ground legitimately remove energy.
 //! - **time to sleep** (s): the simulated time after which every dynamic body was asleep and
 //!   stayed so to the end; `None` if that never happened (or sleeping is disabled).
+//! - **analytic error**: for a scene that declares its closed form (`analytic:` in the scene
+//!   file, an [`Analytic`]), the largest difference between the run and that closed form,
+//!   sampled after every frame; its unit is the declaration's (metres for trajectories and
+//!   apex heights, m/s for the velocities after a collision). `None` for scenes without one.
+//!   It is measured over the whole run, not only after the settle time.
 //!
 //! Cost is the median wall time of one step (the world's own profile total, so the harness's
 //! bookkeeping is not counted), and the median of one *frame* when a frame is several world
@@ -28,8 +33,320 @@
 
 use crate::settings::ResolverChoice;
 use crate::world::{StepError, World};
+use jostle_body::BodyHandle;
 use jostle_math::Vec3;
 use std::time::Duration;
+
+/// A scene's closed form, for the **analytic error** of the module documentation. Declared in
+/// a scene file as `analytic: FreeFall(body: "ball")` and so on; every body named must be a
+/// dynamic body of the scene's `bodies` list, every number finite (validated with the scene,
+/// naming the field). `g` is the magnitude of the scene's gravity; positions are of the
+/// body's centre of mass; t is the simulated time since the start of the run.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
+pub enum Analytic {
+    /// Flight under gravity alone: p(t) = p₀ + v₀t + ½·g⃗·t² (g⃗ the scene's gravity vector).
+    /// Error: the largest |p − p(t)| (m). Semi-implicit Euler leaves ½|g|·t·dt of it, so this
+    /// error shrinks linearly with the step.
+    FreeFall {
+        /// The falling body.
+        body: String,
+    },
+    /// A body released at rest on a plane inclined `angle` degrees with combined friction
+    /// `friction` (μ): it slides with a = g(sin θ − μ cos θ), or holds (a = 0) when
+    /// tan θ ≤ μ, so the distance travelled is s(t) = ½at². Error: the largest
+    /// | |p − p₀| − s(t) | (m).
+    Incline {
+        /// The sliding body.
+        body: String,
+        /// Inclination (degrees), in [0, 90).
+        angle: f32,
+        /// Combined friction coefficient μ (≥ 0) between the body and the plane.
+        friction: f32,
+    },
+    /// A solid ball launched sliding without spin on level ground with combined friction μ:
+    /// friction decelerates it at μg until t* = 2v₀/(7μg), after which it rolls at 5/7 v₀.
+    /// Horizontal distance x(t) = v₀t − ½μgt² before t*, x(t*) + 5/7·v₀(t − t*) after.
+    /// Error: the largest | |horizontal displacement| − x(t) | (m).
+    SlidingToRolling {
+        /// The ball.
+        body: String,
+        /// Combined friction coefficient μ (> 0) between ball and ground.
+        friction: f32,
+    },
+    /// A body dropped from rest onto level ground with combined restitution e: the k-th apex
+    /// is at `rest_height` + e²ᵏ(y₀ − `rest_height`). Error: the largest |apexₖ − closed
+    /// form| (m) over the apexes the closed form has before the run's last frame; an apex the
+    /// run misses counts its whole closed-form height above `rest_height`. An apex is a frame
+    /// where the vertical velocity turns from up to down more than 1 cm above `rest_height`.
+    Bounce {
+        /// The bouncing body.
+        body: String,
+        /// Combined restitution e, in [0, 1].
+        restitution: f32,
+        /// Height of the centre of mass when the body rests on the ground (m).
+        rest_height: f32,
+    },
+    /// A head-on collision of two bodies moving along the line of their centres, with
+    /// combined restitution e: along that line, u′ₐ = (mₐuₐ + m_b u_b − m_b e(uₐ − u_b)) /
+    /// (mₐ + m_b) and u′_b = (mₐuₐ + m_b u_b + mₐe(uₐ − u_b)) / (mₐ + m_b) if they approach,
+    /// unchanged otherwise. Error: the largest |v − v′| of the two bodies at the end of the run
+    /// (m/s).
+    Collision {
+        /// The first body.
+        a: String,
+        /// The second body.
+        b: String,
+        /// Combined restitution e, in [0, 1].
+        restitution: f32,
+    },
+}
+
+impl Analytic {
+    /// The names of the bodies the declaration refers to.
+    pub fn bodies(&self) -> Vec<&str> {
+        match self {
+            Self::FreeFall { body }
+            | Self::Incline { body, .. }
+            | Self::SlidingToRolling { body, .. }
+            | Self::Bounce { body, .. } => vec![body.as_str()],
+            Self::Collision { a, b, .. } => vec![a.as_str(), b.as_str()],
+        }
+    }
+
+    /// Checks the numbers (finite, in range). The error is (field under `analytic.`, message).
+    /// Whether the bodies exist is the scene's to check ([`Analytic::bodies`]).
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        let check = |field: &str, x: f32, ok: bool, range: &str| {
+            if x.is_finite() && ok {
+                Ok(())
+            } else {
+                Err((
+                    format!("analytic.{field}"),
+                    format!("must be finite and {range}, got {x}"),
+                ))
+            }
+        };
+        match self {
+            Self::FreeFall { .. } => Ok(()),
+            Self::Incline {
+                angle, friction, ..
+            } => {
+                check("angle", *angle, (0.0..90.0).contains(angle), "in [0, 90)")?;
+                check("friction", *friction, *friction >= 0.0, ">= 0")
+            }
+            Self::SlidingToRolling { friction, .. } => {
+                check("friction", *friction, *friction > 0.0, "> 0")
+            }
+            Self::Bounce {
+                restitution,
+                rest_height,
+                ..
+            } => {
+                check(
+                    "restitution",
+                    *restitution,
+                    (0.0..=1.0).contains(restitution),
+                    "in [0, 1]",
+                )?;
+                check("rest_height", *rest_height, true, "a height (m)")
+            }
+            Self::Collision { a, b, restitution } => {
+                if a == b {
+                    return Err((
+                        "analytic.b".into(),
+                        format!("must differ from `a` (\"{a}\")"),
+                    ));
+                }
+                check(
+                    "restitution",
+                    *restitution,
+                    (0.0..=1.0).contains(restitution),
+                    "in [0, 1]",
+                )
+            }
+        }
+    }
+}
+
+/// The state of one body at the start of a run, for the closed forms.
+#[derive(Clone, Copy, Debug)]
+struct Start {
+    handle: BodyHandle,
+    position: Vec3,
+    velocity: Vec3,
+    mass: f32,
+}
+
+/// Follows a run against an [`Analytic`] closed form, frame by frame.
+#[derive(Clone, Debug)]
+struct AnalyticTracker {
+    spec: Analytic,
+    g: Vec3,
+    start: Vec<Start>,
+    /// Largest error seen so far (trajectory kinds).
+    error: f64,
+    /// Bounce: apex heights measured so far, and the last frame's vertical velocity.
+    apexes: Vec<f32>,
+    last_vy: f32,
+    last_y: f32,
+}
+
+impl AnalyticTracker {
+    /// Records the start state; an error names a body the world does not have (or a fixed one).
+    fn new(spec: &Analytic, world: &World) -> Result<Self, String> {
+        let mut start = Vec::new();
+        for name in spec.bodies() {
+            let handle = world
+                .find_body(name)
+                .ok_or_else(|| format!("analytic: no body named \"{name}\""))?;
+            let body = world
+                .body(handle)
+                .ok_or_else(|| format!("analytic: no body named \"{name}\""))?;
+            if body.is_fixed() {
+                return Err(format!(
+                    "analytic: body \"{name}\" is fixed; the closed form needs a dynamic body"
+                ));
+            }
+            start.push(Start {
+                handle,
+                position: body.position,
+                velocity: body.linear_velocity,
+                mass: body.mass(),
+            });
+        }
+        Ok(Self {
+            spec: spec.clone(),
+            g: world.settings().gravity,
+            last_vy: start[0].velocity.y,
+            last_y: start[0].position.y,
+            start,
+            error: 0.0,
+            apexes: Vec::new(),
+        })
+    }
+
+    /// Compares the world at simulated time `t` with the closed form.
+    fn observe(&mut self, world: &World, t: f64) {
+        let s = self.start[0];
+        let Some(body) = world.body(s.handle) else {
+            return;
+        };
+        let (p, v) = (body.position, body.linear_velocity);
+        let g = self.g.length() as f64;
+        let err = match &self.spec {
+            Analytic::FreeFall { .. } => {
+                let t = t as f32;
+                let expected = s.position + s.velocity * t + 0.5 * self.g * t * t;
+                Some(p.distance(expected) as f64)
+            }
+            Analytic::Incline {
+                angle, friction, ..
+            } => {
+                let theta = (*angle as f64).to_radians();
+                let a = (g * (theta.sin() - *friction as f64 * theta.cos())).max(0.0);
+                Some((p.distance(s.position) as f64 - 0.5 * a * t * t).abs())
+            }
+            Analytic::SlidingToRolling { friction, .. } => {
+                let up = -self.g.normalize_or(Vec3::NEG_Y);
+                let flat = |x: Vec3| x - up * x.dot(up);
+                let v0 = flat(s.velocity).length() as f64;
+                let mu_g = *friction as f64 * g;
+                let t_roll = if mu_g > 0.0 {
+                    2.0 * v0 / (7.0 * mu_g)
+                } else {
+                    f64::INFINITY
+                };
+                let x = if t < t_roll {
+                    v0 * t - 0.5 * mu_g * t * t
+                } else {
+                    v0 * t_roll - 0.5 * mu_g * t_roll * t_roll + 5.0 / 7.0 * v0 * (t - t_roll)
+                };
+                Some((flat(p - s.position).length() as f64 - x).abs())
+            }
+            Analytic::Bounce { rest_height, .. } => {
+                let top = p.y.max(self.last_y);
+                if self.last_vy > 0.0 && v.y <= 0.0 && top > rest_height + 0.01 {
+                    self.apexes.push(top);
+                }
+                (self.last_vy, self.last_y) = (v.y, p.y);
+                None
+            }
+            Analytic::Collision { .. } => None,
+        };
+        if let Some(e) = err {
+            self.error = self.error.max(e);
+        }
+    }
+
+    /// The analytic error of the run that ended at simulated time `end`.
+    fn finish(&self, world: &World, end: f64) -> f64 {
+        match &self.spec {
+            Analytic::Bounce {
+                restitution,
+                rest_height,
+                ..
+            } => {
+                let (e, rest) = (*restitution as f64, *rest_height as f64);
+                let g = self.g.length() as f64;
+                let h0 = (self.start[0].position.y as f64 - rest).max(0.0);
+                // Closed-form apexes: the fall takes √(2h₀/g); after the k-th impact the body
+                // leaves at eᵏ·√(2gh₀) and spends 2eᵏ√(2h₀/g) in the air.
+                let fall = if g > 0.0 { (2.0 * h0 / g).sqrt() } else { 0.0 };
+                let mut expected = Vec::new();
+                let mut impact = fall;
+                let mut k = 1;
+                while g > 0.0 && h0 > 0.0 && e > 0.0 && k < 64 {
+                    let flight = 2.0 * e.powi(k) * fall;
+                    let apex_time = impact + flight / 2.0;
+                    let height = e.powi(2 * k) * h0;
+                    if apex_time >= end || height <= 0.01 {
+                        break;
+                    }
+                    expected.push(rest + height);
+                    impact += flight;
+                    k += 1;
+                }
+                expected
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &h)| match self.apexes.get(i) {
+                        Some(&y) => (y as f64 - h).abs(),
+                        None => h - rest,
+                    })
+                    .fold(0.0, f64::max)
+            }
+            Analytic::Collision { restitution, .. } => {
+                let (a, b) = (self.start[0], self.start[1]);
+                let d = (b.position - a.position).normalize_or_zero();
+                let (ua, ub) = (a.velocity.dot(d) as f64, b.velocity.dot(d) as f64);
+                let (ma, mb) = (a.mass as f64, b.mass as f64);
+                let e = *restitution as f64;
+                let (ua2, ub2) = if ua - ub > 0.0 {
+                    let p = ma * ua + mb * ub;
+                    (
+                        (p - mb * e * (ua - ub)) / (ma + mb),
+                        (p + ma * e * (ua - ub)) / (ma + mb),
+                    )
+                } else {
+                    (ua, ub)
+                };
+                let expected = |s: Start, u: f64, u2: f64| s.velocity + d * (u2 - u) as f32;
+                let error = |s: Start, u: f64, u2: f64| {
+                    world.body(s.handle).map_or(f64::INFINITY, |body| {
+                        body.linear_velocity.distance(expected(s, u, u2)) as f64
+                    })
+                };
+                error(a, ua, ua2).max(error(b, ub, ub2))
+            }
+            _ => self.error,
+        }
+    }
+}
 
 /// One setting of a sweep: a resolver with its settings and a time step.
 #[derive(Clone, Debug, PartialEq)]
@@ -156,6 +473,20 @@ pub struct Metrics {
     pub energy_error: Option<f64>,
     /// Simulated time until every dynamic body slept for good (s).
     pub time_to_sleep: Option<f64>,
+    /// The run against the scene's closed form (`None` when the scene declares none); unit
+    /// per [`Analytic`] kind.
+    pub analytic_error: Option<f64>,
+}
+
+/// Why [`run_case`] failed.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum BenchError {
+    /// A step failed.
+    #[error(transparent)]
+    Step(#[from] StepError),
+    /// The closed form names a body the world does not have, or a fixed one.
+    #[error("{0}")]
+    Analytic(String),
 }
 
 /// Total mechanical energy (J): kinetic plus gravitational potential, measured from the origin.
@@ -180,13 +511,19 @@ fn dynamic_positions(world: &World) -> Vec<Vec3> {
 
 /// Runs `world` for `duration` seconds of simulated time in frames of `setting.dt` (each
 /// `setting.world_substeps` world steps), measuring from `settle` seconds on, and returns the
-/// metrics. The world is expected to have been built with `setting.resolver`.
+/// metrics; `analytic` is the scene's closed form, if it declares one. The world is expected
+/// to have been built with `setting.resolver`.
 pub fn run_case(
     world: &mut World,
     setting: &Setting,
     duration: f64,
     settle: f64,
-) -> Result<Metrics, StepError> {
+    analytic: Option<&Analytic>,
+) -> Result<Metrics, BenchError> {
+    let mut tracker = analytic
+        .map(|a| AnalyticTracker::new(a, world))
+        .transpose()
+        .map_err(BenchError::Analytic)?;
     let dt = setting.dt as f64;
     let frames = (duration / dt).round().max(1.0) as u64;
     let settle_frame = ((settle / dt).round() as u64).min(frames - 1);
@@ -208,6 +545,9 @@ pub fn run_case(
             t += world.profile().total;
         }
         frame_times.push(t);
+        if let Some(tracker) = &mut tracker {
+            tracker.observe(world, frame as f64 * dt);
+        }
         if closed {
             energy_error = energy_error.max((mechanical_energy(world) - e0).abs());
         }
@@ -256,5 +596,148 @@ pub fn run_case(
         },
         energy_error: closed.then(|| energy_error / e0.abs().max(1.0)),
         time_to_sleep: asleep_since.map(|f| f as f64 * dt),
+        analytic_error: tracker.map(|t| t.finish(world, frames as f64 * dt)),
     })
+}
+
+#[cfg(all(test, feature = "scene"))]
+mod tests {
+    use super::*;
+    use crate::scene::{Scene, SceneError};
+
+    fn default_setting(world: &World, dt: f32) -> Setting {
+        Setting {
+            label: "default".into(),
+            resolver: world.settings().resolver.clone(),
+            dt,
+            world_substeps: 1,
+        }
+    }
+
+    fn setting_error(text: &str) -> (String, String) {
+        match Scene::parse(text, "t.ron") {
+            Err(SceneError::Setting { field, message, .. }) => (field, message),
+            other => panic!("expected a setting error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn analytic_declarations_are_validated_naming_the_field() {
+        let (field, message) = setting_error(
+            "Scene(analytic: FreeFall(body: \"rock\"), bodies: [Body(name: \"ball\", shape: Ball(radius: 0.5))])",
+        );
+        assert_eq!(field, "analytic");
+        assert!(message.contains("rock"), "{message}");
+        let (field, _) = setting_error(
+            "Scene(analytic: FreeFall(body: \"g\"), bodies: [Body(name: \"g\", shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true)])",
+        );
+        assert_eq!(field, "analytic");
+        let (field, message) = setting_error(
+            "Scene(analytic: Bounce(body: \"b\", restitution: 1.5, rest_height: 0.5), bodies: [Body(name: \"b\", shape: Ball(radius: 0.5))])",
+        );
+        assert_eq!(field, "analytic.restitution");
+        assert!(message.contains("1.5"), "{message}");
+        let (field, _) = setting_error(
+            "Scene(analytic: Incline(body: \"b\", angle: 90.0, friction: 0.1), bodies: [Body(name: \"b\", shape: Ball(radius: 0.5))])",
+        );
+        assert_eq!(field, "analytic.angle");
+        let (field, _) = setting_error(
+            "Scene(analytic: Collision(a: \"b\", b: \"b\", restitution: 1.0), bodies: [Body(name: \"b\", shape: Ball(radius: 0.5))])",
+        );
+        assert_eq!(field, "analytic.b");
+    }
+
+    #[test]
+    fn unknown_analytic_fields_and_kinds_report_line_and_column() {
+        for text in [
+            "Scene(\n  analytic: FreeFall(body: \"b\", height: 3.0),\n  bodies: [Body(name: \"b\", shape: Ball(radius: 0.5))])",
+            "Scene(\n  analytic: Orbit(body: \"b\"),\n  bodies: [Body(name: \"b\", shape: Ball(radius: 0.5))])",
+        ] {
+            match Scene::parse(text, "t.ron") {
+                Err(SceneError::Parse { line, column, .. }) => {
+                    assert_eq!(line, 2, "{text}");
+                    assert!(column > 1, "{text}");
+                }
+                other => panic!("expected a parse error, got {other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn free_fall_error_is_the_integrators_half_g_t_h() {
+        let scene = Scene::parse(
+            "Scene(analytic: FreeFall(body: \"b\"), bodies: [Body(name: \"b\", shape: Ball(radius: 0.5), position: (0.0, 10.0, 0.0), can_sleep: false)])",
+            "t.ron",
+        )
+        .unwrap();
+        let mut world = scene.build().unwrap();
+        let setting = default_setting(&world, 1.0 / 60.0);
+        let m = run_case(&mut world, &setting, 1.0, 0.5, scene.analytic.as_ref()).unwrap();
+        let expected = 0.5 * 9.81 * 1.0 / 60.0;
+        let e = m.analytic_error.unwrap();
+        assert!((e - expected).abs() < 1e-3 * expected, "{e} vs {expected}");
+        // No declaration, no analytic error.
+        let mut world = scene.build().unwrap();
+        assert_eq!(
+            run_case(&mut world, &setting, 1.0, 0.5, None)
+                .unwrap()
+                .analytic_error,
+            None
+        );
+    }
+
+    #[test]
+    fn bodies_that_never_meet_have_no_collision_error_and_a_wrong_closed_form_shows() {
+        // Two balls receding in zero gravity: the closed form is "unchanged", which they are.
+        let text = |vb: f32| {
+            format!(
+                "Scene(gravity: (0.0, 0.0, 0.0), analytic: Collision(a: \"a\", b: \"b\", restitution: 1.0), bodies: [\
+                 Body(name: \"a\", shape: Ball(radius: 0.5), linear_velocity: (-1.0, 0.0, 0.0), can_sleep: false),\
+                 Body(name: \"b\", shape: Ball(radius: 0.5), position: (3.0, 0.0, 0.0), linear_velocity: ({vb}, 0.0, 0.0), can_sleep: false)])"
+            )
+        };
+        let scene = Scene::parse(&text(1.0), "t.ron").unwrap();
+        let mut world = scene.build().unwrap();
+        let setting = default_setting(&world, 1.0 / 60.0);
+        let m = run_case(&mut world, &setting, 0.5, 0.1, scene.analytic.as_ref()).unwrap();
+        assert!(m.analytic_error.unwrap() < 1e-6, "{m:?}");
+        // B flying at A at 10 m/s with no time to meet in 0.05 s: the closed form expects the
+        // collision's outcome, the run has not had it, so the error is large.
+        let scene = Scene::parse(&text(-10.0), "t.ron").unwrap();
+        let mut world = scene.build().unwrap();
+        let m = run_case(&mut world, &setting, 0.05, 0.0, scene.analytic.as_ref()).unwrap();
+        assert!(m.analytic_error.unwrap() > 1.0, "{m:?}");
+    }
+
+    #[test]
+    fn the_analytic_set_meets_its_closed_forms_roughly() {
+        // Loose bounds (both resolvers at their defaults, dt 1/60): the point is that each
+        // declared closed form is the scene's, so a wrong sign, unit or parameter would show.
+        // Measured when written: free fall 0.163 (Millington) / 0.041 m (soft step, whose
+        // substeps integrate at dt/4); incline 0.045 / 0.335 m (the soft step slides 7% off
+        // the closed form over 4.7 m); sliding to rolling 0.012 / 0.006 m; bounce 0.027 /
+        // 0.057 m; elastic pair 0 / 0 m/s.
+        for (file, bound) in [
+            ("analytic_free_fall.ron", 0.17),
+            ("analytic_incline.ron", 0.4),
+            ("analytic_sliding_to_rolling.ron", 0.05),
+            ("analytic_bounce.ron", 0.1),
+            ("analytic_elastic_pair.ron", 0.01),
+        ] {
+            let path = format!("{}/assets/{file}", env!("CARGO_MANIFEST_DIR"));
+            let scene = Scene::load(&path).unwrap();
+            assert!(scene.analytic.is_some(), "{file} declares no closed form");
+            for resolver in ResolverChoice::NAMES {
+                let mut settings = scene.settings();
+                settings.resolver = ResolverChoice::from_name(resolver).unwrap();
+                let mut world = scene.build_with(settings).unwrap();
+                let setting = default_setting(&world, scene.dt);
+                let duration = scene.steps as f64 * scene.dt as f64;
+                let m =
+                    run_case(&mut world, &setting, duration, 0.0, scene.analytic.as_ref()).unwrap();
+                let e = m.analytic_error.unwrap();
+                assert!(e.is_finite() && e < bound, "{file} / {resolver}: {e}");
+            }
+        }
+    }
 }

@@ -20,7 +20,9 @@
 //! velocities, `density` 1000 kg/m³ unless `mass` (kg) is given, `friction` 0.5,
 //! `restitution` 0, damping 0, `can_sleep` true, `fixed` false, `ccd` Auto. `generators` add many bodies
 //! from a few parameters (pyramids, stacks, walls, grids of piles). An optional `camera`
-//! ([`Camera`]) fixes the view of renderers; without one they frame the scene themselves.
+//! ([`Camera`]) fixes the view of renderers; without one they frame the scene themselves. An
+//! optional `analytic` ([`crate::bench::Analytic`]) declares the scene's closed form, which
+//! `jostle bench` compares the run against.
 //!
 //! Errors never panic and lose nothing: a malformed file names the file, line and column (and
 //! the body around that position when there is one); a bad value names the body and the field.
@@ -91,6 +93,10 @@ pub struct Scene {
     /// the scene itself.
     #[serde(default)]
     pub camera: Option<Camera>,
+    /// The closed form `jostle bench` compares the run against, for its analytic error
+    /// ([`crate::bench::Analytic`], e.g. `analytic: FreeFall(body: "ball")`). Default: none.
+    #[serde(default)]
+    pub analytic: Option<crate::bench::Analytic>,
 }
 
 fn default_camera_position() -> Vec3 {
@@ -315,6 +321,30 @@ impl Scene {
             g.validate().map_err(|(field, message)| {
                 setting(&format!("generators[{i}].{field}"), message)
             })?;
+        }
+        if let Some(analytic) = &self.analytic {
+            analytic
+                .validate()
+                .map_err(|(field, message)| setting(&field, message))?;
+            for name in analytic.bodies() {
+                match self.bodies.iter().find(|b| b.name == name) {
+                    Some(b) if !b.fixed => {}
+                    Some(_) => {
+                        return Err(setting(
+                            "analytic",
+                            format!(
+                                "body \"{name}\" is fixed; the closed form needs a dynamic body"
+                            ),
+                        ));
+                    }
+                    None => {
+                        return Err(setting(
+                            "analytic",
+                            format!("no body named \"{name}\" in `bodies`"),
+                        ));
+                    }
+                }
+            }
         }
         Ok(())
     }

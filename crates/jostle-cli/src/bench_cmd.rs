@@ -9,8 +9,9 @@
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use jostle::ResolverChoice;
-use jostle::bench::{Metrics, Setting, Sweep, run_case};
+use jostle::bench::{Analytic, Metrics, Setting, Sweep, run_case};
 use jostle::run::{Overrides, load};
+use jostle::scene::Scene;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::fmt::Write as _;
@@ -25,8 +26,9 @@ const DEFAULT_SCENES: [&str; 3] = [
 ];
 
 /// The CSV header of `results.csv`, exactly. Empty fields are metrics that do not apply
-/// (energy error of an open system, time to sleep of a scene that never sleeps).
-pub const CSV_HEADER: &str = "scene,resolver,setting,dt,frames,ms_per_step,ms_per_60hz_step,drift_m,max_penetration_m,mean_penetration_m,energy_error,time_to_sleep_s";
+/// (energy error of an open system, time to sleep of a scene that never sleeps, analytic
+/// error of a scene that declares no closed form).
+pub const CSV_HEADER: &str = "scene,resolver,setting,dt,frames,ms_per_step,ms_per_60hz_step,drift_m,max_penetration_m,mean_penetration_m,energy_error,time_to_sleep_s,analytic_error";
 
 /// Arguments of `jostle bench`.
 #[derive(Args, Debug)]
@@ -97,10 +99,15 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         scene: String,
         setting: Setting,
         duration: f64,
+        analytic: Option<Analytic>,
     }
     let mut cases = Vec::new();
     for path in &scenes {
         let probe = load(path, &Overrides::default()).map_err(|e| e.to_string())?;
+        // The closed form, if the file is a scene that declares one (a snapshot declares none;
+        // `load` above has already parsed and validated the file, so this cannot fail on a
+        // scene file).
+        let analytic = Scene::load(path).ok().and_then(|s| s.analytic);
         let duration = args
             .duration
             .unwrap_or(probe.steps as f64 * probe.dt as f64);
@@ -120,6 +127,7 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
                     scene: probe.name.clone(),
                     setting,
                     duration,
+                    analytic: analytic.clone(),
                 });
             }
         }
@@ -144,8 +152,14 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         };
         let mut setup = load(&case.path, &overrides).map_err(|e| e.to_string())?;
         let settle = args.settle.min(case.duration / 2.0);
-        let metrics = run_case(&mut setup.world, &case.setting, case.duration, settle)
-            .map_err(|e| format!("{}: {e}", case.path.display()))?;
+        let metrics = run_case(
+            &mut setup.world,
+            &case.setting,
+            case.duration,
+            settle,
+            case.analytic.as_ref(),
+        )
+        .map_err(|e| format!("{}: {e}", case.path.display()))?;
         rows.push(Row {
             scene: case.scene,
             resolver: case.setting.resolver.name(),
@@ -186,7 +200,7 @@ fn csv(rows: &[Row]) -> String {
         let m = &r.metrics;
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{:.6},{:.6},{:e},{:e},{:e},{},{}",
+            "{},{},{},{},{},{:.6},{:.6},{:e},{:e},{:e},{},{},{}",
             r.scene.replace(',', ";"),
             r.resolver,
             r.setting.label,
@@ -199,6 +213,7 @@ fn csv(rows: &[Row]) -> String {
             m.mean_penetration,
             opt(m.energy_error, |v| format!("{v:e}")),
             opt(m.time_to_sleep, |v| format!("{v:.4}")),
+            opt(m.analytic_error, |v| format!("{v:e}")),
         );
     }
     out
@@ -208,7 +223,7 @@ fn table(rows: &[Row]) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "{:<22} {:<10} {:<14} {:>9} {:>11} {:>10} {:>10} {:>10} {:>10} {:>8}",
+        "{:<22} {:<10} {:<14} {:>9} {:>11} {:>10} {:>10} {:>10} {:>10} {:>8} {:>10}",
         "scene",
         "resolver",
         "setting",
@@ -218,14 +233,15 @@ fn table(rows: &[Row]) -> String {
         "max pen m",
         "mean pen m",
         "energy err",
-        "sleep s"
+        "sleep s",
+        "analyt err"
     );
     let dash = |x: Option<f64>, prec: usize| x.map_or("-".to_string(), |v| format!("{v:.prec$}"));
     for r in rows {
         let m = &r.metrics;
         let _ = writeln!(
             out,
-            "{:<22} {:<10} {:<14} {:>9.3} {:>11.3} {:>10.2e} {:>10.2e} {:>10.2e} {:>10} {:>8}",
+            "{:<22} {:<10} {:<14} {:>9.3} {:>11.3} {:>10.2e} {:>10.2e} {:>10.2e} {:>10} {:>8} {:>10}",
             r.scene,
             r.resolver,
             r.setting.label,
@@ -236,6 +252,7 @@ fn table(rows: &[Row]) -> String {
             m.mean_penetration,
             m.energy_error.map_or("-".into(), |e| format!("{e:.2e}")),
             dash(m.time_to_sleep, 2),
+            m.analytic_error.map_or("-".into(), |e| format!("{e:.2e}")),
         );
     }
     out
@@ -248,12 +265,45 @@ fn slug(name: &str) -> String {
         .collect()
 }
 
-/// What a scene's plot shows on its y axis: the energy error of a closed system, else drift.
-fn error_of(m: &Metrics, closed: bool) -> f64 {
-    if closed {
-        m.energy_error.unwrap_or(0.0)
-    } else {
-        m.drift as f64
+/// Which error a scene's plot shows on its y axis.
+#[derive(Clone, Copy, PartialEq)]
+enum Plotted {
+    /// The analytic error, for a scene that declares its closed form.
+    Analytic,
+    /// The energy error of a closed system.
+    Energy,
+    /// Drift, for everything else.
+    Drift,
+}
+
+impl Plotted {
+    /// The error shown for rows of one scene: analytic if every row has it, else energy if
+    /// every row has it, else drift.
+    fn of(rows: &[&Row]) -> Self {
+        if rows.iter().all(|r| r.metrics.analytic_error.is_some()) {
+            Self::Analytic
+        } else if rows.iter().all(|r| r.metrics.energy_error.is_some()) {
+            Self::Energy
+        } else {
+            Self::Drift
+        }
+    }
+
+    fn label(self) -> &'static str {
+        match self {
+            Self::Analytic => "analytic error",
+            Self::Energy => "relative energy error",
+            Self::Drift => "drift (m)",
+        }
+    }
+}
+
+/// The plotted error of one row.
+fn error_of(m: &Metrics, plotted: Plotted) -> f64 {
+    match plotted {
+        Plotted::Analytic => m.analytic_error.unwrap_or(0.0),
+        Plotted::Energy => m.energy_error.unwrap_or(0.0),
+        Plotted::Drift => m.drift as f64,
     }
 }
 
@@ -264,7 +314,7 @@ const FLOOR: f64 = 1e-7;
 /// curve per resolver, points in sweep order.
 fn plot_scene(out: &Path, name: &str, rows: &[&Row]) -> Result<Vec<PathBuf>, String> {
     register_font();
-    let closed = rows.iter().all(|r| r.metrics.energy_error.is_some());
+    let plotted = Plotted::of(rows);
     let base = out.join(slug(name));
     let svg = base.with_extension("svg");
     let png = base.with_extension("png");
@@ -273,14 +323,14 @@ fn plot_scene(out: &Path, name: &str, rows: &[&Row]) -> Result<Vec<PathBuf>, Str
         SVGBackend::new(&svg, SIZE).into_drawing_area(),
         name,
         rows,
-        closed,
+        plotted,
     )?;
     let mut buf = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
     draw(
         BitMapBackend::with_buffer(&mut buf, SIZE).into_drawing_area(),
         name,
         rows,
-        closed,
+        plotted,
     )?;
     image::save_buffer(&png, &buf, SIZE.0, SIZE.1, image::ExtendedColorType::Rgb8)
         .map_err(|e| format!("{}: cannot write: {e}", png.display()))?;
@@ -297,23 +347,21 @@ fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     name: &str,
     rows: &[&Row],
-    closed: bool,
+    plotted: Plotted,
 ) -> Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plot of {name}: {e}");
     root.fill(&WHITE).map_err(err)?;
     // Costs span orders of magnitude between resolvers, so both axes are logarithmic.
     let xs = rows.iter().map(|r| r.metrics.ms_per_60hz_step.max(FLOOR));
-    let ys = rows.iter().map(|r| error_of(&r.metrics, closed).max(FLOOR));
+    let ys = rows
+        .iter()
+        .map(|r| error_of(&r.metrics, plotted).max(FLOOR));
     let (x_min, x_max) = xs.fold((f64::MAX, 0.0f64), |(lo, hi), x| (lo.min(x), hi.max(x)));
     // Room on the right for the legend, clear of every point.
     let (x_min, x_max) = (x_min / 1.5, (x_max * 6.0).max(x_min * 40.0));
     let (y_min, y_max) = ys.fold((f64::MAX, 0.0f64), |(lo, hi), y| (lo.min(y), hi.max(y)));
     let (y_min, y_max) = (y_min / 2.0, (y_max * 2.0).max(y_min * 10.0));
-    let metric = if closed {
-        "relative energy error"
-    } else {
-        "drift (m)"
-    };
+    let metric = plotted.label();
     let mut chart = ChartBuilder::on(&root)
         .caption(format!("{name}: {metric} against cost"), ("sans-serif", 22))
         .margin(16)
@@ -340,7 +388,7 @@ fn draw<DB: DrawingBackend>(
             .map(|r| {
                 (
                     r.metrics.ms_per_60hz_step.max(FLOOR),
-                    error_of(&r.metrics, closed).max(FLOOR),
+                    error_of(&r.metrics, plotted).max(FLOOR),
                 )
             })
             .collect();

@@ -9,7 +9,7 @@ fn temp_dir() -> PathBuf {
     dir
 }
 
-const HEADER: [&str; 12] = [
+const HEADER: [&str; 13] = [
     "scene",
     "resolver",
     "setting",
@@ -22,6 +22,7 @@ const HEADER: [&str; 12] = [
     "mean_penetration_m",
     "energy_error",
     "time_to_sleep_s",
+    "analytic_error",
 ];
 
 #[test]
@@ -44,11 +45,20 @@ fn bench_writes_csv_with_finite_metrics_and_both_plots() {
            Body(name: \"box\", shape: Cuboid(half_extents: (0.5, 0.25, 0.1)), angular_velocity: (0.0, 3.0, 0.0), can_sleep: false)])",
     )
     .unwrap();
+    // A ball in free fall for 1 s that declares its closed form: the analytic error.
+    let fall = dir.join("fall.ron");
+    std::fs::write(
+        &fall,
+        "Scene(name: \"tiny fall\", steps: 60, analytic: FreeFall(body: \"ball\"), bodies: [\
+           Body(name: \"ball\", shape: Ball(radius: 0.5), position: (0.0, 10.0, 0.0), can_sleep: false)])",
+    )
+    .unwrap();
     let out_dir = dir.join("out");
     let out = Command::new(env!("CARGO_BIN_EXE_jostle"))
         .arg("bench")
         .arg(&rest)
         .arg(&spin)
+        .arg(&fall)
         .args(["--sweep", "substeps", "--settle", "0.5", "--out"])
         .arg(&out_dir)
         .output()
@@ -68,17 +78,19 @@ fn bench_writes_csv_with_finite_metrics_and_both_plots() {
     let mut lines = csv.lines();
     assert_eq!(lines.next().unwrap().split(',').collect::<Vec<_>>(), HEADER);
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
-    // 2 scenes × 2 resolvers × 4 substep settings.
-    assert_eq!(rows.len(), 16, "{csv}");
+    // 3 scenes × 2 resolvers × 4 substep settings.
+    assert_eq!(rows.len(), 24, "{csv}");
     let col = |name: &str| HEADER.iter().position(|h| *h == name).unwrap();
     for row in &rows {
         assert_eq!(row.len(), HEADER.len(), "{row:?}");
-        let closed = row[0] == "tiny spin";
+        let (spin, fall) = (row[0] == "tiny spin", row[0] == "tiny fall");
         for (i, field) in row.iter().enumerate().skip(3) {
-            // Energy error applies to the closed system only; time to sleep to the resting box.
+            // Energy error applies to the closed systems only (no fixed body), time to sleep to
+            // the resting box, analytic error to the scene that declares its closed form.
             let applies = match HEADER[i] {
-                "energy_error" => closed,
-                "time_to_sleep_s" => !closed,
+                "energy_error" => spin || fall,
+                "time_to_sleep_s" => !spin && !fall,
+                "analytic_error" => fall,
                 _ => true,
             };
             if applies {
@@ -91,9 +103,33 @@ fn bench_writes_csv_with_finite_metrics_and_both_plots() {
             }
         }
         assert!(row[col("ms_per_step")].parse::<f64>().unwrap() > 0.0);
+        if fall {
+            // Semi-implicit Euler falls ½·g·t·h ahead of y₀ − ½gt² (h the integration step:
+            // 1/60 s, or less with substeps): 0.0818 m after 1 s at h = 1/60, never more.
+            let e: f64 = row[col("analytic_error")].parse().unwrap();
+            assert!(
+                e > 1e-4 && e < 0.0818 * 1.01,
+                "free-fall analytic error {e} in {row:?}"
+            );
+        }
     }
+    // The free fall's analytic error shrinks with the step: Millington's substeps are world
+    // steps of dt/n, so 8 of them leave an eighth of the error of 1.
+    let fall_error = |setting: &str| -> f64 {
+        rows.iter()
+            .find(|r| r[0] == "tiny fall" && r[1] == "millington" && r[2] == setting)
+            .unwrap_or_else(|| panic!("no millington {setting} row for tiny fall"))
+            [col("analytic_error")]
+        .parse()
+        .unwrap()
+    };
+    let (one, eight) = (fall_error("substeps=1"), fall_error("substeps=8"));
+    assert!(
+        (eight * 8.0 - one).abs() < 0.02 * one,
+        "analytic error at 1 substep {one}, at 8 substeps {eight}"
+    );
 
-    for stem in ["tiny_rest", "tiny_spin"] {
+    for stem in ["tiny_rest", "tiny_spin", "tiny_fall"] {
         for ext in ["svg", "png"] {
             let p = out_dir.join(format!("{stem}.{ext}"));
             let len = std::fs::metadata(&p)
