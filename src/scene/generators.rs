@@ -88,8 +88,10 @@ pub enum Generator {
         #[serde(default)]
         name: Option<String>,
     },
-    /// A brick wall in the XY plane, `columns` bricks long and `rows` high, every other row
-    /// offset by half a brick.
+    /// A brick wall in the XY plane, `columns` bricks long and `rows` high, in running bond:
+    /// every other row is offset by half a brick and closed at both ends with a half brick
+    /// (`columns` − 1 whole bricks and two halves), so both ends of the wall are flush and no
+    /// brick overhangs the row below.
     Wall {
         /// Bricks per row.
         columns: u32,
@@ -379,18 +381,30 @@ impl Generator {
                 name,
             } => {
                 let name = name.as_deref().unwrap_or("wall");
+                // The wall spans x in ±columns·he.x about the origin.
+                let left = -(*columns as f32) * he.x;
                 for row in 0..*rows {
-                    let shift = if row % 2 == 1 { he.x } else { 0.0 };
-                    for c in 0..*columns {
-                        let x = (c as f32 - (*columns - 1) as f32 / 2.0) * 2.0 * he.x + shift;
-                        let centre = *origin + Vec3::new(x, he.y * (2 * row + 1) as f32, 0.0);
+                    let y = he.y * (2 * row + 1) as f32;
+                    let mut brick = |x: f32, half: Vec3| {
                         out.push(cuboid(
                             format!("{name}-{}", out.len()),
-                            *he,
-                            centre,
+                            half,
+                            *origin + Vec3::new(x, y, 0.0),
                             *friction,
                             *density,
                         ));
+                    };
+                    if row % 2 == 0 {
+                        for c in 0..*columns {
+                            brick(left + (2 * c + 1) as f32 * he.x, *he);
+                        }
+                    } else {
+                        let half = Vec3::new(0.5 * he.x, he.y, he.z);
+                        brick(left + 0.5 * he.x, half);
+                        for c in 1..*columns {
+                            brick(left + (2 * c) as f32 * he.x, *he);
+                        }
+                        brick(-left - 0.5 * he.x, half);
                     }
                 }
             }
