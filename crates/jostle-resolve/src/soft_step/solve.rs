@@ -237,7 +237,14 @@ fn solve_friction(pair: &mut Pair, p: &mut PointLanes) {
     let len_sq = new1 * new1 + new2 * new2;
     let over = len_sq.cmpgt(limit * limit);
     if over.any() {
-        [new1, new2] = project_to_disk(p.tangent_mass, [new1, new2], limit, over);
+        // Most lanes over the limit have none (no normal impulse: a speculative contact, an
+        // unloaded corner) and simply get no friction; the projection is for the others.
+        if (over & limit.cmpgt(F8::ZERO)).any() {
+            [new1, new2] = project_to_disk(p.tangent_mass, [new1, new2], limit, over);
+        } else {
+            new1 = F8::select(over, F8::ZERO, new1);
+            new2 = F8::select(over, F8::ZERO, new2);
+        }
     }
     p.tangent_impulse = [new1, new2];
     pair.apply_tangent(p, new1 - old1, new2 - old2);
