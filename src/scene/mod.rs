@@ -311,6 +311,10 @@ impl Scene {
                 .validate()
                 .map_err(|(field, message)| setting(&field, message))?;
         }
+        if let Some(ResolverChoice::SoftStep(soft)) = &self.resolver {
+            soft.validate()
+                .map_err(|(field, message)| setting(&format!("resolver.{field}"), message))?;
+        }
         for body in &self.bodies {
             body.to_desc().map_err(|e| SceneError::Body {
                 file: String::new(),

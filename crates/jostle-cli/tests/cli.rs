@@ -247,6 +247,12 @@ fn every_bad_input_exits_non_zero_with_a_precise_message() {
             &["dt"],
         ),
         (
+            "soft-step setting out of range",
+            "Scene(resolver: SoftStep(contact_hertz: -30.0))".into(),
+            vec![],
+            &["resolver.contact_hertz", "-30"],
+        ),
+        (
             "negative --dt",
             "Scene()".into(),
             vec!["--dt=-1"],

@@ -88,6 +88,9 @@ pub struct PointLanes {
     pub relative_velocity: F8,
 }
 
+// 192 bytes per contact point: 11 vectors and 15 scalars, each eight lanes wide.
+const _: () = assert!(size_of::<PointLanes>() <= 192 * LANES);
+
 /// Eight manifolds (one per lane) with disjoint non-static bodies; their points are
 /// `points[first .. first + count]` of the [`Batches`].
 #[derive(Clone, Copy, Debug, PartialEq)]
