@@ -52,6 +52,10 @@ pub struct BodyDesc {
     /// Continuous collision detection: `Auto` (swept only when fast for its size), `On` or
     /// `Off`. Ignored for fixed bodies.
     pub ccd: CcdMode,
+    /// Lock the rotation: the body translates but never turns (zero inverse inertia; the
+    /// resolvers skip its angular terms). Default false. `angular_velocity` must then be zero.
+    /// Ignored for fixed bodies.
+    pub lock_rotation: bool,
 }
 
 impl BodyDesc {
@@ -74,6 +78,7 @@ impl BodyDesc {
             can_sleep: true,
             fixed: false,
             ccd: CcdMode::Auto,
+            lock_rotation: false,
         }
     }
 
@@ -101,6 +106,12 @@ impl BodyDesc {
     pub fn moving(mut self, linear: Vec3, angular: Vec3) -> Self {
         self.linear_velocity = linear;
         self.angular_velocity = angular;
+        self
+    }
+
+    /// Locks the rotation (see [`BodyDesc::lock_rotation`]).
+    pub fn with_locked_rotation(mut self) -> Self {
+        self.lock_rotation = true;
         self
     }
 
@@ -148,6 +159,15 @@ impl BodyDesc {
         vec("position", self.position)?;
         vec("linear_velocity", self.linear_velocity)?;
         vec("angular_velocity", self.angular_velocity)?;
+        if self.lock_rotation && !self.fixed && self.angular_velocity != Vec3::ZERO {
+            return Err(err(
+                "angular_velocity",
+                format!(
+                    "must be zero when lock_rotation is set, got {}",
+                    self.angular_velocity
+                ),
+            ));
+        }
         if !self.rotation.is_finite() || self.rotation.length_squared() < 1e-12 {
             return Err(err(
                 "rotation",

@@ -137,9 +137,12 @@ impl World {
                     message: format!("mass properties are degenerate: {e}"),
                 })?;
             let com = desc.position + rotation * props.local_com;
-            let body = body
+            let mut body = body
                 .with_pose(com, rotation)
                 .with_velocity(desc.linear_velocity, desc.angular_velocity);
+            if desc.lock_rotation {
+                body.lock_rotation();
+            }
             (
                 body,
                 jostle_collide::Pose::from_translation(-props.local_com),
@@ -290,7 +293,8 @@ impl World {
         Ok(())
     }
 
-    /// Sets the velocities; wakes the body's island.
+    /// Sets the velocities; wakes the body's island. The angular velocity of a body whose
+    /// rotation is locked stays zero.
     pub fn set_velocity(
         &mut self,
         handle: BodyHandle,
@@ -301,7 +305,9 @@ impl World {
         Self::finite("angular velocity", angular)?;
         let body = self.body_mut_awake(handle)?;
         body.linear_velocity = linear;
-        body.angular_velocity = angular;
+        if !body.is_rotation_locked() {
+            body.angular_velocity = angular;
+        }
         Ok(())
     }
 

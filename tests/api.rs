@@ -122,3 +122,90 @@ fn a_body_that_goes_non_finite_is_quarantined_and_the_rest_steps_on() {
         "the rest of the world keeps stepping"
     );
 }
+
+/// A body with locked rotation takes an off-centre impulse as pure translation, keeps a
+/// tilted pose while it lands on a corner (an unlocked box topples), and refuses an initial
+/// spin by name and field; with both resolvers.
+#[test]
+fn a_body_with_locked_rotation_never_turns() {
+    let (mut world, _) = world_with_ball();
+    let locked = world
+        .add_body(
+            BodyDesc::dynamic("locked", ShapeDesc::Ball { radius: 0.5 })
+                .at(Vec3::new(5.0, 0.0, 0.0))
+                .with_mass(2.0)
+                .with_locked_rotation(),
+        )
+        .unwrap();
+    world
+        .apply_impulse_at_point(locked, Vec3::new(0.0, 0.0, 4.0), Vec3::new(5.5, 0.0, 0.0))
+        .unwrap();
+    world.step(1.0 / 60.0).unwrap();
+    let b = world.body(locked).unwrap();
+    assert!(b.is_rotation_locked());
+    assert_eq!(b.angular_velocity, Vec3::ZERO);
+    assert!((b.linear_velocity - Vec3::new(0.0, 0.0, 2.0)).length() < 1e-6);
+
+    for resolver in [
+        jostle::ResolverChoice::Millington(Default::default()),
+        jostle::ResolverChoice::SoftStep(Default::default()),
+    ] {
+        // A cube tilted 30° about z, dropped onto the ground on one edge.
+        let mut world = World::new(WorldSettings {
+            resolver: resolver.clone(),
+            ..Default::default()
+        });
+        world
+            .add_body(BodyDesc::fixed(
+                "ground",
+                ShapeDesc::HalfSpace { normal: Vec3::Y },
+            ))
+            .unwrap();
+        let tilt = jostle::Quat::from_rotation_z(std::f32::consts::FRAC_PI_6);
+        let half = Vec3::splat(0.5);
+        let drop = |name: &str| {
+            BodyDesc::dynamic(name, ShapeDesc::Cuboid { half_extents: half })
+                .at(Vec3::new(0.0, 1.0, 0.0))
+                .rotated(tilt)
+        };
+        let locked = world
+            .add_body(drop("locked").with_locked_rotation())
+            .unwrap();
+        let free = world
+            .add_body(drop("free").at(Vec3::new(5.0, 1.0, 0.0)))
+            .unwrap();
+        for _ in 0..120 {
+            world.step(1.0 / 60.0).unwrap();
+        }
+        let angle = |h| {
+            let q: jostle::Quat = world.body(h).unwrap().orientation;
+            q.angle_between(tilt)
+        };
+        assert_eq!(angle(locked), 0.0, "{resolver:?}: the locked cube turned");
+        assert!(
+            angle(free) > 0.3,
+            "{resolver:?}: the free cube should topple"
+        );
+        let rest = world.body(locked).unwrap().position.y;
+        // Resting on its lowest edge: the centre is half a diagonal of the tilted face above.
+        let edge = 0.5 * (std::f32::consts::FRAC_PI_6.cos() + std::f32::consts::FRAC_PI_6.sin());
+        assert!(
+            (rest - edge).abs() < 0.01,
+            "{resolver:?}: locked cube at {rest}, edge {edge}"
+        );
+    }
+
+    let mut world = World::new(WorldSettings::default());
+    let err = world
+        .add_body(
+            BodyDesc::dynamic("spinner", ShapeDesc::Ball { radius: 0.5 })
+                .moving(Vec3::ZERO, Vec3::new(0.0, 1.0, 0.0))
+                .with_locked_rotation(),
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("spinner") && err.contains("angular_velocity"),
+        "{err}"
+    );
+}

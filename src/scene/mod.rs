@@ -203,6 +203,9 @@ pub struct BodySpec {
     /// Continuous collision detection: `Auto`, `On` or `Off`. Default `Auto`.
     #[serde(default)]
     pub ccd: jostle_body::CcdMode,
+    /// Lock the rotation (the body translates but never turns). Default false.
+    #[serde(default)]
+    pub lock_rotation: bool,
 }
 
 fn identity() -> Quat {
@@ -241,6 +244,7 @@ impl BodySpec {
             can_sleep: self.can_sleep,
             fixed: self.fixed,
             ccd: self.ccd,
+            lock_rotation: self.lock_rotation,
         };
         desc.validate()?;
         Ok(desc)

@@ -185,6 +185,24 @@ impl RigidBody {
         self.inv_inertia_world
     }
 
+    /// Locks the body's rotation: its inverse inertia becomes zero, so no contact, impulse or
+    /// torque turns it, and resolvers skip its angular terms altogether; its angular velocity
+    /// is set to zero. The mass and the stored inertia (for [`RigidBody::kinetic_energy`]) are
+    /// kept. Does nothing to a fixed body.
+    pub fn lock_rotation(&mut self) {
+        if self.fixed {
+            return;
+        }
+        self.inv_inertia_body = Mat3::ZERO;
+        self.angular_velocity = Vec3::ZERO;
+        self.update_world_inertia();
+    }
+
+    /// Whether the body's rotation is locked ([`RigidBody::lock_rotation`]).
+    pub fn is_rotation_locked(&self) -> bool {
+        !self.fixed && self.inv_inertia_body == Mat3::ZERO
+    }
+
     /// Recomputes the world inverse inertia from the orientation; call after changing
     /// `orientation` directly.
     pub fn update_world_inertia(&mut self) {

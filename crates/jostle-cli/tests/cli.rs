@@ -247,6 +247,14 @@ fn every_bad_input_exits_non_zero_with_a_precise_message() {
             &["dt"],
         ),
         (
+            "spin on a body with locked rotation",
+            body(
+                "shape: Ball(radius: 1.0), lock_rotation: true, angular_velocity: (0.0, 1.0, 0.0)",
+            ),
+            vec![],
+            &["culprit", "angular_velocity", "lock_rotation"],
+        ),
+        (
             "soft-step setting out of range",
             "Scene(resolver: SoftStep(contact_hertz: -30.0))".into(),
             vec![],
