@@ -14,8 +14,8 @@
 //!   e = 0.5 against e = 0.
 //! - **zero inverse inertia** (`SolverBody::ROTATES` clear: every angular term skipped): the
 //!   synthetic stacks as built against the same bodies with zero inverse inertia and the flag
-//!   cleared. The facade has no way to lock a body's rotation yet, so this pair exists at the
-//!   resolver level only.
+//!   cleared; and at world level, `piles_1000` settled with every box free to rotate against
+//!   every box with `lock_rotation` set (`BodyDesc::lock_rotation`), each resolver.
 //! - **unmoved pairs** (narrow-phase manifold reuse when a pair's relative pose moved less than
 //!   `CollideSettings::reuse_linear` / `reuse_angular`, 1e-4 m / 1e-4 rad), world level: the
 //!   settled scene with the default tolerances against the same scene with both set to 0
@@ -52,12 +52,12 @@ struct Row {
     work: String,
 }
 
-/// A settled world of `asset` with the given resolver, sleeping off, friction overridden when
-/// `friction` is given, and the collide settings changed by `collide`.
+/// A settled world of `asset` with the given resolver, sleeping off, every body description
+/// changed by `edit` (friction, locked rotation) and the collide settings by `collide`.
 fn world(
     asset: &str,
     resolver: &str,
-    friction: Option<f32>,
+    edit: impl Fn(&mut jostle::BodyDesc),
     collide: impl Fn(&mut jostle::CollideSettings),
     settle: usize,
 ) -> World {
@@ -68,9 +68,7 @@ fn world(
     collide(&mut settings.collide);
     let mut world = World::new(settings);
     for mut desc in scene.body_descs().expect("scene bodies") {
-        if let Some(mu) = friction {
-            desc.material.friction = mu;
-        }
+        edit(&mut desc);
         world.add_body(desc).expect("body");
     }
     for _ in 0..settle {
@@ -240,11 +238,35 @@ fn main() {
         for (case, mu) in [("mu_0.6", 0.6), ("mu_0", 0.0)] {
             cases.push((
                 format!("{name}/{case}"),
-                world("piles_1000", name, Some(mu), |_| {}, settle),
+                world(
+                    "piles_1000",
+                    name,
+                    |d| d.material.friction = mu,
+                    |_| {},
+                    settle,
+                ),
             ));
         }
     }
     bench_world(&mut c, &mut rows, "skip_friction_piles_1000", cases, false);
+
+    // Zero inverse inertia, world level: every box of the piles with its rotation locked.
+    let mut cases = Vec::new();
+    for name in RESOLVERS {
+        for (case, lock) in [("rotates", false), ("lock_rotation", true)] {
+            cases.push((
+                format!("{name}/{case}"),
+                world(
+                    "piles_1000",
+                    name,
+                    |d| d.lock_rotation = lock && !d.fixed,
+                    |_| {},
+                    settle,
+                ),
+            ));
+        }
+    }
+    bench_world(&mut c, &mut rows, "skip_rotation_piles_1000", cases, false);
 
     // μ = 0, e = 0 and zero inverse inertia, resolver only.
     bench_synthetic(
@@ -274,14 +296,14 @@ fn main() {
         let cases = vec![
             (
                 "reuse_on".to_string(),
-                world(asset, "soft-step", None, |_| {}, settle),
+                world(asset, "soft-step", |_| {}, |_| {}, settle),
             ),
             (
                 "reuse_off".to_string(),
                 world(
                     asset,
                     "soft-step",
-                    None,
+                    |_| {},
                     |s| {
                         s.reuse_linear = 0.0;
                         s.reuse_angular = 0.0;
