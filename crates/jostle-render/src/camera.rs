@@ -1,7 +1,7 @@
 //! The perspective camera: where the eye is, what it looks at, and the projection from world
 //! space to pixels; and the default framing of a world.
 //!
-//! In: a [`Camera`] (from code or a scene file) and the image size. Out: a [`Projection`] that
+//! In: a [`Camera`] (from code or a scene file) and the image size. Out: a `Projection` that
 //! maps world points to view space (x right, y up, z the depth in front of the eye) and view
 //! space to pixel coordinates with 1/z for the depth buffer. +Y is up; a camera looking
 //! straight up or down uses −Z as its up instead.

@@ -38,7 +38,7 @@ pub fn velocity_change_per_unit_impulse(p: &PreparedContact) -> f32 {
 
 /// The contact-space matrix K mapping a contact-space impulse on A to the change of A's
 /// closing velocity relative to B (seed lecture, "Computing Impulse"):
-/// K = Mᵀ (Σ −[r]× I⁻¹ [r]×) M + (Σ 1/m) 𝟙, summed over the moving sides, M the basis.
+/// K = Mᵀ (Σ −\[r\]× I⁻¹ \[r\]×) M + (Σ 1/m) 𝟙, summed over the moving sides, M the basis.
 pub fn impulse_matrix(p: &PreparedContact, bodies: &[SolverBody]) -> Mat3 {
     let mut angular = Mat3::ZERO;
     let mut inv_mass = 0.0;

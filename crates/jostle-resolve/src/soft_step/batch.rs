@@ -1,4 +1,4 @@
-//! Packing prepared contacts into eight-lane batches of independent manifolds.
+//! Preparing and packing contacts into eight-lane batches of independent manifolds.
 //!
 //! The soft-step kernels solve eight contact manifolds at once, one per SIMD lane
 //! ([`super::lanes`]). Eight manifolds can share a batch only if no two of them write the same
@@ -78,7 +78,7 @@ pub struct PointLanes {
     pub ang_b_tangent1: V3x8,
     /// I_B⁻¹·(r_B × t₂).
     pub ang_b_tangent2: V3x8,
-    /// Inverse 2×2 tangent effective mass (symmetric: [0,0], [0,1], [1,1]).
+    /// Inverse 2×2 tangent effective mass (symmetric: \[0,0\], \[0,1\], \[1,1\]).
     pub tangent_mass: [F8; 3],
     /// Accumulated friction impulse along t₁, t₂ (N·s).
     pub tangent_impulse: [F8; 2],

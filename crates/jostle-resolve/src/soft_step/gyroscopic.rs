@@ -5,14 +5,14 @@
 //! so in world space I·ω̇ = −ω × (I·ω). Explicit integration of that torque gains energy and
 //! explodes; dropping it (as most game engines do) conserves nothing and a box spun about its
 //! intermediate axis never flips (the Dzhanibekov effect). Catto linearises the implicit step
-//! once about ω₁: J·Δω = −h·ω₁ × (I·ω₁) with J = I + h·([ω₁]×·I − [I·ω₁]×).
+//! once about ω₁: J·Δω = −h·ω₁ × (I·ω₁) with J = I + h·(\[ω₁\]×·I − \[I·ω₁\]×).
 //!
 //! Backward Euler (that J) is dissipative, and too much so for the acceptance test:
 //! for a 1 × 0.5 × 0.2 m box spun at 10 rad/s about its intermediate axis it loses 18.8% of
 //! its kinetic energy in 10 s at h = 1/240 s (5.3% at 1/960; measured with an exact
 //! body-frame reference, and the same 18.8% through the engine). Here the step is the
 //! linearised **implicit midpoint** rule instead: the same system with the Jacobian taken at
-//! h/2, J = I + (h/2)·([ω₁]×·I − [I·ω₁]×), the same cost (one 3×3 solve). The midpoint rule
+//! h/2, J = I + (h/2)·(\[ω₁\]×·I − \[I·ω₁\]×), the same cost (one 3×3 solve). The midpoint rule
 //! preserves the quadratic invariants of Euler's equations (energy and |L|); linearised, it
 //! keeps the box's energy to 0.019% over 10 s at 1/240 s and 0.3% at 1/60 s. It is not
 //! dissipative, so at extreme rates (hω > 1 rad per substep) it could gain energy; the step

@@ -14,7 +14,8 @@
 //!    warm start (apply the accumulated impulses); solve every contact once with its soft bias,
 //!    the separation recomputed from the bodies' motion since the start of the step;
 //!    integrate velocities into position and rotation deltas; relax (solve again without
-//!    bias).
+//!    bias). Friction is solved in the relax pass only, unless
+//!    [`SoftStepSettings::friction_in_bias_pass`] is set.
 //! 3. restitution, skipped when no contact has e > 0;
 //! 4. store the impulses and the remaining penetration in the contacts, the poses and
 //!    velocities in the bodies.
@@ -22,8 +23,9 @@
 //! Unlike the Millington resolver there is no position projection: overlap is removed by the
 //! soft constraint's bias velocity, which the relax pass then takes back out, so resolving
 //! overlap does not make things bounce. The contacts are solved simultaneously (in a fixed
-//! order, colour by colour, to convergence over the substeps), so a Newton's cradle of touching balls does not
-//! give the textbook one-ball-out answer; momentum and energy are still conserved.
+//! order, colour by colour, to convergence over the substeps), so a Newton's cradle of
+//! touching balls does not give the textbook one-ball-out answer; momentum and energy are
+//! still conserved.
 //!
 //! In: solver bodies and contacts. Out: moved bodies, each contact's impulse and remaining
 //! penetration. Depends on `jostle-math` alone.

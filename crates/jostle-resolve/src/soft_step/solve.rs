@@ -251,7 +251,7 @@ fn solve_friction(pair: &mut Pair, p: &mut PointLanes) {
 }
 
 /// The point of the disk of radius `r` closest to `target` in the metric of K, where
-/// `inv_k` = K⁻¹ (symmetric: [0,0], [0,1], [1,1]), for the lanes in `over` (|target| > r ≥ 0);
+/// `inv_k` = K⁻¹ (symmetric: \[0,0\], \[0,1\], \[1,1\]), for the lanes in `over` (|target| > r ≥ 0);
 /// other lanes keep `target`. Lanes whose K⁻¹ is singular fall back to scaling `target` onto
 /// the disk. The result is scaled onto the circle exactly, so |λ| ≤ r holds to rounding.
 #[inline(always)]
