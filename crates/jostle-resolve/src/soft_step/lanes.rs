@@ -13,9 +13,7 @@
 
 use jostle_math::glam::{BVec4A, Vec4};
 use jostle_math::{Quat, Vec3};
-use std::ops::{
-    Add, AddAssign, BitAnd, BitOr, Div, Index, IndexMut, Mul, MulAssign, Neg, Sub, SubAssign,
-};
+use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Index, IndexMut, Mul, Neg, Sub, SubAssign};
 
 /// Number of lanes.
 pub const WIDTH: usize = 8;
@@ -187,13 +185,6 @@ impl Neg for F8 {
     }
 }
 
-impl MulAssign for F8 {
-    #[inline]
-    fn mul_assign(&mut self, o: Self) {
-        *self = *self * o;
-    }
-}
-
 /// Eight 3-vectors, one per lane, stored by component.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C)]
@@ -279,18 +270,6 @@ impl Sub for V3x8 {
     }
 }
 
-impl Neg for V3x8 {
-    type Output = Self;
-    #[inline]
-    fn neg(self) -> Self {
-        Self {
-            x: -self.x,
-            y: -self.y,
-            z: -self.z,
-        }
-    }
-}
-
 impl Mul<F8> for V3x8 {
     type Output = Self;
     #[inline]
@@ -341,19 +320,6 @@ impl Q8 {
         self.w[i] = q.w;
     }
 
-    /// Packs eight quaternions, lane i from `q[i]`.
-    #[inline]
-    pub fn from_lanes(q: [Quat; WIDTH]) -> Self {
-        Self {
-            v: V3x8 {
-                x: F8::from_array(q.map(|q| q.x)),
-                y: F8::from_array(q.map(|q| q.y)),
-                z: F8::from_array(q.map(|q| q.z)),
-            },
-            w: F8::from_array(q.map(|q| q.w)),
-        }
-    }
-
     /// Rotates `r` by each lane's quaternion: r + w·t + v × t with t = 2·(v × r), the
     /// expansion of q·r·q* for a unit q.
     #[inline]
@@ -396,7 +362,11 @@ mod tests {
             ),
         });
         let r = lanes();
-        let rotated = Q8::from_lanes(q).rotate(V3x8::from_lanes(r));
+        let mut packed = Q8::IDENTITY;
+        for (i, q) in q.iter().enumerate() {
+            packed.set_lane(i, *q);
+        }
+        let rotated = packed.rotate(V3x8::from_lanes(r));
         for i in 0..WIDTH {
             let d = rotated.lane(i) - q[i] * r[i];
             assert!(d.length() < 1e-5, "lane {i}: {d}");
