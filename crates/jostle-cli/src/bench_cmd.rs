@@ -39,6 +39,9 @@ pub struct BenchArgs {
     #[arg(long = "resolver", value_name = "NAME")]
     resolvers: Vec<String>,
     /// Vary one setting: iterations, substeps or dt. Default: each scene's own settings only.
+    /// A resolver the scene declares runs with the scene's settings (labelled "scene" when they
+    /// differ from the defaults), and a sweep starts from them; the other resolver runs with its
+    /// defaults.
     #[arg(long)]
     sweep: Option<String>,
     /// Output directory for results.csv and the plots (created if missing).
@@ -111,12 +114,19 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         let duration = args
             .duration
             .unwrap_or(probe.steps as f64 * probe.dt as f64);
+        let own = &probe.world.settings().resolver;
         for resolver in &resolvers {
+            // The scene's own settings when it declares this resolver, else the defaults.
+            let (base, label) = if own.name() == resolver.name() && own != resolver {
+                (own, "scene")
+            } else {
+                (resolver, "default")
+            };
             let settings = match sweep {
-                Some(s) => s.settings(resolver, probe.dt),
+                Some(s) => s.settings(base, probe.dt),
                 None => vec![Setting {
-                    label: "default".into(),
-                    resolver: resolver.clone(),
+                    label: label.into(),
+                    resolver: base.clone(),
                     dt: probe.dt,
                     world_substeps: 1,
                 }],
