@@ -39,53 +39,53 @@ pub const NO_SOURCE: u32 = u32::MAX;
 /// it; a padding lane holds zeros.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C)]
-pub struct PointLanes {
+pub struct PointLanes<F = F8> {
     /// Unit normal from B toward A.
-    pub normal: V3x8,
+    pub normal: V3x8<F>,
     /// Anchor relative to A's centre of mass at the start of the step (m).
-    pub r_a: V3x8,
+    pub r_a: V3x8<F>,
     /// Anchor relative to B's centre of mass at the start of the step (m).
-    pub r_b: V3x8,
+    pub r_b: V3x8<F>,
     /// I_A⁻¹·(r_A × n).
-    pub ang_a_normal: V3x8,
+    pub ang_a_normal: V3x8<F>,
     /// I_B⁻¹·(r_B × n).
-    pub ang_b_normal: V3x8,
+    pub ang_b_normal: V3x8<F>,
     /// Adjusted separation at the start of the step (m).
-    pub base_separation: F8,
+    pub base_separation: F,
     /// Normal effective mass (kg).
-    pub normal_mass: F8,
+    pub normal_mass: F,
     /// Accumulated normal impulse (N·s).
-    pub normal_impulse: F8,
+    pub normal_impulse: F,
     /// Largest normal impulse increment of the step (N·s).
-    pub max_normal_impulse: F8,
+    pub max_normal_impulse: F,
     /// Soft bias rate (1/s).
-    pub bias_rate: F8,
+    pub bias_rate: F,
     /// Soft mass scale.
-    pub mass_scale: F8,
+    pub mass_scale: F,
     /// Soft impulse scale.
-    pub impulse_scale: F8,
+    pub impulse_scale: F,
     /// Friction coefficient μ.
-    pub friction: F8,
+    pub friction: F,
     /// First tangent.
-    pub tangent1: V3x8,
+    pub tangent1: V3x8<F>,
     /// Second tangent.
-    pub tangent2: V3x8,
+    pub tangent2: V3x8<F>,
     /// I_A⁻¹·(r_A × t₁).
-    pub ang_a_tangent1: V3x8,
+    pub ang_a_tangent1: V3x8<F>,
     /// I_A⁻¹·(r_A × t₂).
-    pub ang_a_tangent2: V3x8,
+    pub ang_a_tangent2: V3x8<F>,
     /// I_B⁻¹·(r_B × t₁).
-    pub ang_b_tangent1: V3x8,
+    pub ang_b_tangent1: V3x8<F>,
     /// I_B⁻¹·(r_B × t₂).
-    pub ang_b_tangent2: V3x8,
+    pub ang_b_tangent2: V3x8<F>,
     /// Inverse 2×2 tangent effective mass (symmetric: \[0,0\], \[0,1\], \[1,1\]).
-    pub tangent_mass: [F8; 3],
+    pub tangent_mass: [F; 3],
     /// Accumulated friction impulse along t₁, t₂ (N·s).
-    pub tangent_impulse: [F8; 2],
+    pub tangent_impulse: [F; 2],
     /// Restitution e.
-    pub restitution: F8,
+    pub restitution: F,
     /// Normal relative velocity at the start of the step (m/s).
-    pub relative_velocity: F8,
+    pub relative_velocity: F,
 }
 
 // 192 bytes per contact point: 11 vectors and 15 scalars, each eight lanes wide.
@@ -94,15 +94,16 @@ const _: () = assert!(size_of::<PointLanes>() <= 192 * LANES);
 /// Eight manifolds (one per lane) with disjoint non-static bodies; their points are
 /// `points[first .. first + count]` of the [`Batches`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ManifoldLanes {
+#[repr(C)]
+pub struct ManifoldLanes<F = F8> {
     /// Solver index of body A per lane ([`STATIC_BODY`] for a padding lane).
     pub a: [u32; LANES],
     /// Solver index of body B per lane.
     pub b: [u32; LANES],
     /// 1/m of A per lane (1/kg).
-    pub inv_mass_a: F8,
+    pub inv_mass_a: F,
     /// 1/m of B per lane (1/kg).
-    pub inv_mass_b: F8,
+    pub inv_mass_b: F,
     /// Index of the first [`PointLanes`] of this batch.
     pub first: u32,
     /// Number of [`PointLanes`]: the most points of any lane.

@@ -1,15 +1,17 @@
 //! Eight-lane arithmetic for the soft-step kernels: one lane per contact manifold.
 //!
 //! [`F8`] is eight `f32` lanes held as two glam `Vec4`s, each a 128-bit SIMD register on
-//! x86-64 (SSE2) and aarch64 (NEON) and four plain floats elsewhere. Eight lanes rather than
-//! four because a batch's points are solved one after the other, each depending on the
-//! velocities the previous one left: one four-lane chain keeps the CPU waiting on latency,
-//! two independent halves interleaved keep it busy. [`V3x8`] is eight 3-vectors stored by
-//! component (x of the eight lanes, then y, then z), so a dot product of eight lanes is three
-//! multiplies and two adds per half and a cross product six multiplies and three
-//! subtractions, with no shuffles. [`Q8`] is eight quaternions stored the same way. Every
-//! operation is lane-wise IEEE arithmetic, so results do not depend on the lane a contact
-//! lands in.
+//! x86-64 (SSE2) and aarch64 (NEON) and four plain floats elsewhere; it is what contacts are
+//! prepared and stored in. The kernels are generic over the [`Lane`] trait, and on x86-64 CPUs
+//! with AVX they run with the 256-bit type of the private `lanes_avx` module instead, reading the same
+//! storage in place (one instruction per operation instead of two, identical results). Eight
+//! lanes rather than four because a batch's points are solved one after the other, each
+//! depending on the velocities the previous one left: one four-lane chain keeps the CPU
+//! waiting on latency, eight independent lanes keep it busy. [`V3x8`] is eight 3-vectors
+//! stored by component (x of the eight lanes, then y, then z), so a dot product of eight lanes
+//! is three multiplies and two adds and a cross product six multiplies and three subtractions,
+//! with no shuffles. [`Q8`] is eight quaternions stored the same way. Every operation is
+//! lane-wise IEEE arithmetic, so results do not depend on the lane a contact lands in.
 
 use jostle_math::glam::{BVec4A, Vec4};
 use jostle_math::{Quat, Vec3};
@@ -18,9 +20,10 @@ use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Index, IndexMut, Mul, Neg, Su
 /// Number of lanes.
 pub const WIDTH: usize = 8;
 
-/// Eight `f32` lanes.
+/// Eight `f32` lanes, aligned to 32 bytes so that structures of them have the layout of
+/// their 256-bit counterparts (the private `lanes_avx` module).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-#[repr(C)]
+#[repr(C, align(32))]
 pub struct F8([Vec4; 2]);
 
 /// Eight-lane boolean mask (result of a lane-wise comparison).
@@ -43,7 +46,7 @@ macro_rules! halves {
 macro_rules! compare {
     ($name:ident) => {
         #[doc = concat!("Lane-wise `", stringify!($name), "`.")]
-        #[inline]
+        #[inline(always)]
         pub fn $name(self, o: Self) -> M8 {
             M8([self.0[0].$name(o.0[0]), self.0[1].$name(o.0[1])])
         }
@@ -57,13 +60,13 @@ impl F8 {
     pub const ONE: Self = Self([Vec4::ONE; 2]);
 
     /// All lanes `x`.
-    #[inline]
+    #[inline(always)]
     pub fn splat(x: f32) -> Self {
         Self([Vec4::splat(x); 2])
     }
 
     /// Lane i from `a[i]`.
-    #[inline]
+    #[inline(always)]
     pub fn from_array(a: [f32; WIDTH]) -> Self {
         Self([
             Vec4::new(a[0], a[1], a[2], a[3]),
@@ -72,7 +75,7 @@ impl F8 {
     }
 
     /// Lane-wise `if mask { t } else { f }`.
-    #[inline]
+    #[inline(always)]
     pub fn select(mask: M8, t: Self, f: Self) -> Self {
         Self([
             Vec4::select(mask.0[0], t.0[0], f.0[0]),
@@ -81,37 +84,37 @@ impl F8 {
     }
 
     /// Lane-wise maximum (glam's: the second operand when either is NaN).
-    #[inline]
+    #[inline(always)]
     pub fn max(self, o: Self) -> Self {
         halves!(|a, b| a.max(b), self, o)
     }
 
     /// Lane-wise square root.
-    #[inline]
+    #[inline(always)]
     pub fn sqrt(self) -> Self {
         halves!(|a| a.sqrt(), self)
     }
 
     /// Lane-wise 1/x.
-    #[inline]
+    #[inline(always)]
     pub fn recip(self) -> Self {
         halves!(|a| a.recip(), self)
     }
 
     /// Lane-wise |x|.
-    #[inline]
+    #[inline(always)]
     pub fn abs(self) -> Self {
         halves!(|a| a.abs(), self)
     }
 
     /// The largest lane.
-    #[inline]
+    #[inline(always)]
     pub fn max_element(self) -> f32 {
         self.0[0].max(self.0[1]).max_element()
     }
 
     /// Lanes that are finite.
-    #[inline]
+    #[inline(always)]
     pub fn is_finite_mask(self) -> M8 {
         M8([self.0[0].is_finite_mask(), self.0[1].is_finite_mask()])
     }
@@ -124,7 +127,7 @@ impl F8 {
 
 impl M8 {
     /// Whether any lane is set.
-    #[inline]
+    #[inline(always)]
     pub fn any(self) -> bool {
         self.0[0].any() || self.0[1].any()
     }
@@ -132,7 +135,7 @@ impl M8 {
 
 impl BitAnd for M8 {
     type Output = Self;
-    #[inline]
+    #[inline(always)]
     fn bitand(self, o: Self) -> Self {
         Self([self.0[0] & o.0[0], self.0[1] & o.0[1]])
     }
@@ -140,7 +143,7 @@ impl BitAnd for M8 {
 
 impl BitOr for M8 {
     type Output = Self;
-    #[inline]
+    #[inline(always)]
     fn bitor(self, o: Self) -> Self {
         Self([self.0[0] | o.0[0], self.0[1] | o.0[1]])
     }
@@ -148,14 +151,14 @@ impl BitOr for M8 {
 
 impl Index<usize> for F8 {
     type Output = f32;
-    #[inline]
+    #[inline(always)]
     fn index(&self, i: usize) -> &f32 {
         &self.0[i / 4][i % 4]
     }
 }
 
 impl IndexMut<usize> for F8 {
-    #[inline]
+    #[inline(always)]
     fn index_mut(&mut self, i: usize) -> &mut f32 {
         &mut self.0[i / 4][i % 4]
     }
@@ -165,7 +168,7 @@ macro_rules! binary {
     ($tr:ident, $f:ident, $op:tt) => {
         impl $tr for F8 {
             type Output = Self;
-            #[inline]
+            #[inline(always)]
             fn $f(self, o: Self) -> Self {
                 halves!(|a, b| a $op b, self, o)
             }
@@ -179,34 +182,135 @@ binary!(Div, div, /);
 
 impl Neg for F8 {
     type Output = Self;
-    #[inline]
+    #[inline(always)]
     fn neg(self) -> Self {
         halves!(|a| -a, self)
+    }
+}
+
+/// Eight-lane arithmetic as the kernels use it: [`F8`] (two 128-bit halves) everywhere, and
+/// on x86-64 CPUs with AVX a 256-bit type (the private `lanes_avx` module) inside kernels compiled for
+/// it. Every operation is lane-wise IEEE arithmetic with the same semantics in both, so the
+/// kernels give bit-identical results with either.
+pub trait Lane:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + Index<usize, Output = f32>
+    + IndexMut<usize>
+{
+    /// The result of a lane-wise comparison.
+    type Mask: LaneMask;
+    /// All lanes zero.
+    const ZERO: Self;
+    /// All lanes one.
+    const ONE: Self;
+    /// All lanes `x`.
+    fn splat(x: f32) -> Self;
+    /// Lane-wise `if mask { t } else { f }`.
+    fn select(mask: Self::Mask, t: Self, f: Self) -> Self;
+    /// Lane-wise maximum: `self` where it is greater, else `o` (so `o` when either is NaN,
+    /// x86's `maxps`).
+    fn max(self, o: Self) -> Self;
+    /// Lane-wise square root.
+    fn sqrt(self) -> Self;
+    /// Lane-wise 1/x.
+    fn recip(self) -> Self;
+    /// Lane-wise |x|.
+    fn abs(self) -> Self;
+    /// Lanes that are finite.
+    fn is_finite_mask(self) -> Self::Mask;
+    /// Lane-wise `>`.
+    fn cmpgt(self, o: Self) -> Self::Mask;
+    /// Lane-wise `<`.
+    fn cmplt(self, o: Self) -> Self::Mask;
+    /// Lane-wise `<=`.
+    fn cmple(self, o: Self) -> Self::Mask;
+    /// Lane-wise `==`.
+    fn cmpeq(self, o: Self) -> Self::Mask;
+}
+
+/// A lane-wise boolean mask of a [`Lane`] type.
+pub trait LaneMask: Copy + BitAnd<Output = Self> + BitOr<Output = Self> {
+    /// Whether any lane is set.
+    fn any(self) -> bool;
+}
+
+impl Lane for F8 {
+    type Mask = M8;
+    const ZERO: Self = F8::ZERO;
+    const ONE: Self = F8::ONE;
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        F8::splat(x)
+    }
+    #[inline(always)]
+    fn select(mask: M8, t: Self, f: Self) -> Self {
+        F8::select(mask, t, f)
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        F8::max(self, o)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        F8::sqrt(self)
+    }
+    #[inline(always)]
+    fn recip(self) -> Self {
+        F8::recip(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        F8::abs(self)
+    }
+    #[inline(always)]
+    fn is_finite_mask(self) -> M8 {
+        F8::is_finite_mask(self)
+    }
+    #[inline(always)]
+    fn cmpgt(self, o: Self) -> M8 {
+        F8::cmpgt(self, o)
+    }
+    #[inline(always)]
+    fn cmplt(self, o: Self) -> M8 {
+        F8::cmplt(self, o)
+    }
+    #[inline(always)]
+    fn cmple(self, o: Self) -> M8 {
+        F8::cmple(self, o)
+    }
+    #[inline(always)]
+    fn cmpeq(self, o: Self) -> M8 {
+        F8::cmpeq(self, o)
+    }
+}
+
+impl LaneMask for M8 {
+    #[inline(always)]
+    fn any(self) -> bool {
+        M8::any(self)
     }
 }
 
 /// Eight 3-vectors, one per lane, stored by component.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C)]
-pub struct V3x8 {
+pub struct V3x8<F = F8> {
     /// The x components of the eight lanes.
-    pub x: F8,
+    pub x: F,
     /// The y components.
-    pub y: F8,
+    pub y: F,
     /// The z components.
-    pub z: F8,
+    pub z: F,
 }
 
 impl V3x8 {
-    /// All lanes zero.
-    pub const ZERO: Self = Self {
-        x: F8::ZERO,
-        y: F8::ZERO,
-        z: F8::ZERO,
-    };
-
     /// Packs eight vectors, lane i from `v[i]`.
-    #[inline]
+    #[inline(always)]
     pub fn from_lanes(v: [Vec3; WIDTH]) -> Self {
         Self {
             x: F8::from_array(v.map(|v| v.x)),
@@ -214,15 +318,24 @@ impl V3x8 {
             z: F8::from_array(v.map(|v| v.z)),
         }
     }
+}
+
+impl<F: Lane> V3x8<F> {
+    /// All lanes zero.
+    pub const ZERO: Self = Self {
+        x: F::ZERO,
+        y: F::ZERO,
+        z: F::ZERO,
+    };
 
     /// Lane `i` as a vector.
-    #[inline]
+    #[inline(always)]
     pub fn lane(&self, i: usize) -> Vec3 {
         Vec3::new(self.x[i], self.y[i], self.z[i])
     }
 
     /// Sets lane `i` to `v`.
-    #[inline]
+    #[inline(always)]
     pub fn set_lane(&mut self, i: usize, v: Vec3) {
         self.x[i] = v.x;
         self.y[i] = v.y;
@@ -230,13 +343,13 @@ impl V3x8 {
     }
 
     /// Lane-wise dot product.
-    #[inline]
-    pub fn dot(self, o: Self) -> F8 {
+    #[inline(always)]
+    pub fn dot(self, o: Self) -> F {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
 
     /// Lane-wise cross product.
-    #[inline]
+    #[inline(always)]
     pub fn cross(self, o: Self) -> Self {
         Self {
             x: self.y * o.z - self.z * o.y,
@@ -246,9 +359,9 @@ impl V3x8 {
     }
 }
 
-impl Add for V3x8 {
+impl<F: Lane> Add for V3x8<F> {
     type Output = Self;
-    #[inline]
+    #[inline(always)]
     fn add(self, o: Self) -> Self {
         Self {
             x: self.x + o.x,
@@ -258,9 +371,9 @@ impl Add for V3x8 {
     }
 }
 
-impl Sub for V3x8 {
+impl<F: Lane> Sub for V3x8<F> {
     type Output = Self;
-    #[inline]
+    #[inline(always)]
     fn sub(self, o: Self) -> Self {
         Self {
             x: self.x - o.x,
@@ -270,10 +383,10 @@ impl Sub for V3x8 {
     }
 }
 
-impl Mul<F8> for V3x8 {
+impl<F: Lane> Mul<F> for V3x8<F> {
     type Output = Self;
-    #[inline]
-    fn mul(self, s: F8) -> Self {
+    #[inline(always)]
+    fn mul(self, s: F) -> Self {
         Self {
             x: self.x * s,
             y: self.y * s,
@@ -282,15 +395,15 @@ impl Mul<F8> for V3x8 {
     }
 }
 
-impl AddAssign for V3x8 {
-    #[inline]
+impl<F: Lane> AddAssign for V3x8<F> {
+    #[inline(always)]
     fn add_assign(&mut self, o: Self) {
         *self = *self + o;
     }
 }
 
-impl SubAssign for V3x8 {
-    #[inline]
+impl<F: Lane> SubAssign for V3x8<F> {
+    #[inline(always)]
     fn sub_assign(&mut self, o: Self) {
         *self = *self - o;
     }
@@ -299,22 +412,22 @@ impl SubAssign for V3x8 {
 /// Eight unit quaternions, one per lane, stored by component.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
-pub struct Q8 {
+pub struct Q8<F = F8> {
     /// The vector parts (x, y, z) of the eight lanes.
-    pub v: V3x8,
+    pub v: V3x8<F>,
     /// The scalar parts (w).
-    pub w: F8,
+    pub w: F,
 }
 
-impl Q8 {
+impl<F: Lane> Q8<F> {
     /// All lanes the identity rotation.
     pub const IDENTITY: Self = Self {
         v: V3x8::ZERO,
-        w: F8::ONE,
+        w: F::ONE,
     };
 
     /// Sets lane `i` to `q`.
-    #[inline]
+    #[inline(always)]
     pub fn set_lane(&mut self, i: usize, q: Quat) {
         self.v.set_lane(i, Vec3::new(q.x, q.y, q.z));
         self.w[i] = q.w;
@@ -322,9 +435,9 @@ impl Q8 {
 
     /// Rotates `r` by each lane's quaternion: r + w·t + v × t with t = 2·(v × r), the
     /// expansion of q·r·q* for a unit q.
-    #[inline]
-    pub fn rotate(&self, r: V3x8) -> V3x8 {
-        let t = self.v.cross(r) * F8::splat(2.0);
+    #[inline(always)]
+    pub fn rotate(&self, r: V3x8<F>) -> V3x8<F> {
+        let t = self.v.cross(r) * F::splat(2.0);
         r + t * self.w + self.v.cross(t)
     }
 }

@@ -38,6 +38,8 @@ pub mod body_state;
 pub mod gyroscopic;
 pub mod integrate;
 pub mod lanes;
+#[cfg(target_arch = "x86_64")]
+mod lanes_avx;
 pub mod prepare;
 pub mod settings;
 pub mod softness;

@@ -20,25 +20,27 @@
 
 use super::batch::{Batches, LANES, ManifoldLanes, PointLanes};
 use super::body_state::BodyState;
-use super::lanes::{F8, Q8, V3x8};
+use super::lanes::{F8, Lane, LaneMask, Q8, V3x8};
+#[cfg(target_arch = "x86_64")]
+use super::lanes_avx::W8;
 use crate::STATIC_BODY;
 
 /// The velocities of eight bodies, by lane.
 #[derive(Clone, Copy)]
-struct Velocities {
-    linear: V3x8,
-    angular: V3x8,
+struct Velocities<F> {
+    linear: V3x8<F>,
+    angular: V3x8<F>,
 }
 
 /// The motion of eight bodies since the start of the step, by lane.
 #[derive(Clone, Copy)]
-struct Motion {
-    position: V3x8,
-    rotation: Q8,
+struct Motion<F> {
+    position: V3x8<F>,
+    rotation: Q8<F>,
 }
 
 #[inline(always)]
-fn gather_velocities(states: &[BodyState], idx: [u32; LANES]) -> Velocities {
+fn gather_velocities<F: Lane>(states: &[BodyState], idx: [u32; LANES]) -> Velocities<F> {
     let mut v = Velocities {
         linear: V3x8::ZERO,
         angular: V3x8::ZERO,
@@ -52,7 +54,7 @@ fn gather_velocities(states: &[BodyState], idx: [u32; LANES]) -> Velocities {
 }
 
 #[inline(always)]
-fn gather_motion(states: &[BodyState], idx: [u32; LANES]) -> Motion {
+fn gather_motion<F: Lane>(states: &[BodyState], idx: [u32; LANES]) -> Motion<F> {
     let mut m = Motion {
         position: V3x8::ZERO,
         rotation: Q8::IDENTITY,
@@ -66,7 +68,7 @@ fn gather_motion(states: &[BodyState], idx: [u32; LANES]) -> Motion {
 }
 
 #[inline(always)]
-fn scatter_velocities(states: &mut [BodyState], idx: [u32; LANES], v: &Velocities) {
+fn scatter_velocities<F: Lane>(states: &mut [BodyState], idx: [u32; LANES], v: &Velocities<F>) {
     for (lane, &i) in idx.iter().enumerate() {
         if i != STATIC_BODY {
             let s = &mut states[i as usize];
@@ -77,16 +79,16 @@ fn scatter_velocities(states: &mut [BodyState], idx: [u32; LANES], v: &Velocitie
 }
 
 /// A batch's two sides during a kernel: velocities loaded, written back by [`Pair::store`].
-struct Pair {
-    a: Velocities,
-    b: Velocities,
-    inv_mass_a: F8,
-    inv_mass_b: F8,
+struct Pair<F> {
+    a: Velocities<F>,
+    b: Velocities<F>,
+    inv_mass_a: F,
+    inv_mass_b: F,
 }
 
-impl Pair {
-    #[inline]
-    fn load(m: &ManifoldLanes, states: &[BodyState]) -> Self {
+impl<F: Lane> Pair<F> {
+    #[inline(always)]
+    fn load(m: &ManifoldLanes<F>, states: &[BodyState]) -> Self {
         Self {
             a: gather_velocities(states, m.a),
             b: gather_velocities(states, m.b),
@@ -95,22 +97,22 @@ impl Pair {
         }
     }
 
-    #[inline]
-    fn store(&self, m: &ManifoldLanes, states: &mut [BodyState]) {
+    #[inline(always)]
+    fn store(&self, m: &ManifoldLanes<F>, states: &mut [BodyState]) {
         scatter_velocities(states, m.a, &self.a);
         scatter_velocities(states, m.b, &self.b);
     }
 
     /// Velocity of A's material point relative to B's at the contact (m/s).
-    #[inline]
-    fn relative_velocity(&self, p: &PointLanes) -> V3x8 {
+    #[inline(always)]
+    fn relative_velocity(&self, p: &PointLanes<F>) -> V3x8<F> {
         (self.a.linear + self.a.angular.cross(p.r_a))
             - (self.b.linear + self.b.angular.cross(p.r_b))
     }
 
     /// Applies the normal impulse `lambda` (on A along n, on B opposite).
-    #[inline]
-    fn apply_normal(&mut self, p: &PointLanes, lambda: F8) {
+    #[inline(always)]
+    fn apply_normal(&mut self, p: &PointLanes<F>, lambda: F) {
         let impulse = p.normal * lambda;
         self.a.linear += impulse * self.inv_mass_a;
         self.a.angular += p.ang_a_normal * lambda;
@@ -119,8 +121,8 @@ impl Pair {
     }
 
     /// Applies the tangent impulse (`l1` along t₁, `l2` along t₂; on A, opposite on B).
-    #[inline]
-    fn apply_tangent(&mut self, p: &PointLanes, l1: F8, l2: F8) {
+    #[inline(always)]
+    fn apply_tangent(&mut self, p: &PointLanes<F>, l1: F, l2: F) {
         let impulse = p.tangent1 * l1 + p.tangent2 * l2;
         self.a.linear += impulse * self.inv_mass_a;
         self.a.angular += p.ang_a_tangent1 * l1 + p.ang_a_tangent2 * l2;
@@ -132,57 +134,132 @@ impl Pair {
 /// The separation now (m, negative on overlap) from the bodies' motion since the start of
 /// the step: s₀ + ((Δx_A + Δq_A·r_A) − (Δx_B + Δq_B·r_B))·n with r the step-start anchors
 /// (exact for rigid motion of the anchors; the normal is kept fixed, as in Box2D).
-#[inline]
-fn separation(p: &PointLanes, a: &Motion, b: &Motion) -> F8 {
+#[inline(always)]
+fn separation<F: Lane>(p: &PointLanes<F>, a: &Motion<F>, b: &Motion<F>) -> F {
     let pa = a.position + a.rotation.rotate(p.r_a);
     let pb = b.position + b.rotation.rotate(p.r_b);
     p.base_separation + (pa - pb).dot(p.normal)
 }
 
-/// Defines `pub fn $name` running the `#[inline(always)]` body `$imp`, on x86-64 CPUs with
-/// AVX-512VL compiled for them: the kernels keep eight bodies' velocities and a point's data
-/// live at once, more than SSE's 16 vector registers hold, and AVX-512VL's 32 registers
-/// remove the spills. The instructions are the same lane-wise IEEE operations (no fused
-/// multiply-add is introduced), so results are bit-identical on every CPU; only the register
-/// allocation differs. Measured on the 20-row pyramid (`jostle run assets/pyramid_20.ron`,
-/// AMD EPYC with AVX-512): the resolve stage takes 0.245 ms per step this way against 0.264
-/// ms with SSE registers only, results bit for bit the same.
+/// Defines `pub fn $name(batches, …)` running the `#[inline(always)]` generic body
+/// `$imp::<F>(manifolds, points, …)`. On x86-64 CPUs with AVX the body runs compiled for AVX
+/// with `W8` lanes (one 256-bit register per eight lanes, read in place from the
+/// [`F8`]-prepared batches, whose layout is the same), and with AVX-512VL compiled for it too:
+/// the kernels keep eight bodies' velocities and a point's data live at once, more than the
+/// 16 vector registers of SSE or AVX hold, and AVX-512VL's 32 registers remove the spills.
+/// Elsewhere it runs with [`F8`] lanes (two 128-bit halves). The lane operations are the same
+/// IEEE operations in all three (no fused multiply-add is introduced), so results are
+/// bit-identical on every CPU. Measured on the 20-row pyramid (`jostle run
+/// assets/pyramid_20.ron`, AMD EPYC with AVX-512): see RESULTS.md, "Each pipeline stage".
 macro_rules! wide_kernel {
-    ($(#[$doc:meta])* pub fn $name:ident($($arg:ident: $ty:ty),*) -> $ret:ty = $imp:ident;) => {
+    ($(#[$doc:meta])* pub fn $name:ident(batches: &mut Batches $(, $arg:ident: $ty:ty)*) -> $ret:ty = $imp:ident;) => {
         $(#[$doc])*
-        pub fn $name($($arg: $ty),*) -> $ret {
+        pub fn $name(batches: &mut Batches $(, $arg: $ty)*) -> $ret {
+            let Batches {
+                manifolds, points, ..
+            } = batches;
             #[cfg(target_arch = "x86_64")]
             {
                 #[target_feature(enable = "avx512f,avx512vl")]
-                fn wide($($arg: $ty),*) -> $ret {
-                    $imp($($arg),*)
+                fn avx512(
+                    manifolds: &[ManifoldLanes<W8>],
+                    points: &mut [PointLanes<W8>]
+                    $(, $arg: $ty)*
+                ) -> $ret {
+                    $imp(manifolds, points $(, $arg)*)
                 }
-                if std::arch::is_x86_feature_detected!("avx512vl") {
-                    // SAFETY: the CPU has just been detected to support the enabled features.
-                    return unsafe { wide($($arg),*) };
+                #[target_feature(enable = "avx")]
+                fn avx(
+                    manifolds: &[ManifoldLanes<W8>],
+                    points: &mut [PointLanes<W8>]
+                    $(, $arg: $ty)*
+                ) -> $ret {
+                    $imp(manifolds, points $(, $arg)*)
+                }
+                match avx_level() {
+                    AvxLevel::Avx512 => {
+                        let (manifolds, points) = as_wide(manifolds, points);
+                        // SAFETY: the CPU has been detected to support the enabled features.
+                        return unsafe { avx512(manifolds, points $(, $arg)*) };
+                    }
+                    AvxLevel::Avx => {
+                        let (manifolds, points) = as_wide(manifolds, points);
+                        // SAFETY: as above.
+                        return unsafe { avx(manifolds, points $(, $arg)*) };
+                    }
+                    AvxLevel::None => {}
                 }
             }
-            $imp($($arg),*)
+            $imp::<F8>(manifolds, points $(, $arg)*)
         }
     };
 }
 
-/// Runs `$body` for every batch of `$batches` in order, with `$m` the batch, `$pair` its
-/// loaded bodies (stored back after the body), `$points` its points and `$states` the body
-/// states (read only inside). A macro rather than a closure so the body is compiled inline,
-/// with the caller's target features.
+/// Which 256-bit kernels the CPU can run.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum AvxLevel {
+    /// AVX-512F and AVX-512VL: 256-bit lanes and 32 vector registers.
+    Avx512,
+    /// AVX: 256-bit lanes, 16 registers.
+    Avx,
+    /// Neither: the 128-bit kernels.
+    None,
+}
+
+#[cfg(target_arch = "x86_64")]
+fn avx_level() -> AvxLevel {
+    if std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512vl")
+    {
+        AvxLevel::Avx512
+    } else if std::arch::is_x86_feature_detected!("avx") {
+        AvxLevel::Avx
+    } else {
+        AvxLevel::None
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+const _: () = {
+    assert!(size_of::<PointLanes<W8>>() == size_of::<PointLanes<F8>>());
+    assert!(align_of::<PointLanes<W8>>() == align_of::<PointLanes<F8>>());
+    assert!(size_of::<ManifoldLanes<W8>>() == size_of::<ManifoldLanes<F8>>());
+    assert!(align_of::<ManifoldLanes<W8>>() == align_of::<ManifoldLanes<F8>>());
+};
+
+/// The batches viewed with `W8` lanes.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn as_wide<'a>(
+    manifolds: &'a [ManifoldLanes<F8>],
+    points: &'a mut [PointLanes<F8>],
+) -> (&'a [ManifoldLanes<W8>], &'a mut [PointLanes<W8>]) {
+    // SAFETY: `ManifoldLanes` and `PointLanes` are `repr(C)`, and `W8` has `F8`'s size and
+    // alignment (asserted above, and in `lanes_avx`), so both instantiations have the same
+    // layout; every bit pattern is a valid `W8`. The borrows are carried over unchanged.
+    unsafe {
+        (
+            std::slice::from_raw_parts(manifolds.as_ptr().cast(), manifolds.len()),
+            std::slice::from_raw_parts_mut(points.as_mut_ptr().cast(), points.len()),
+        )
+    }
+}
+
+/// Runs `$body` for every batch in order, with `$m` the batch, `$pair` its loaded bodies
+/// (stored back after the body), `$points` its points and `$st` the body states (read only
+/// inside). A macro rather than a closure so the body is compiled inline, with the caller's
+/// target features.
 macro_rules! for_each_batch {
-    ($batches:expr, $states:expr, |$m:ident, $pair:ident, $points:ident, $st:ident| $body:block) => {{
-        let Batches {
-            manifolds, points, ..
-        } = $batches;
+    ($manifolds:expr, $points:expr, $states:expr, |$m:ident, $pair:ident, $pts:ident, $st:ident| $body:block) => {{
         let states: &mut [BodyState] = $states;
-        for $m in manifolds.iter() {
+        let all_points = $points;
+        for $m in $manifolds.iter() {
             let mut pair = Pair::load($m, states);
             let range = $m.first as usize..($m.first + $m.count) as usize;
             {
                 let $pair = &mut pair;
-                let $points = &mut points[range];
+                let $pts = &mut all_points[range];
                 let $st: &[BodyState] = states;
                 $body
             }
@@ -192,8 +269,12 @@ macro_rules! for_each_batch {
 }
 
 #[inline(always)]
-fn warm_start_impl(batches: &mut Batches, states: &mut [BodyState]) {
-    for_each_batch!(batches, states, |m, pair, points, _states| {
+fn warm_start_impl<F: Lane>(
+    manifolds: &[ManifoldLanes<F>],
+    points: &mut [PointLanes<F>],
+    states: &mut [BodyState],
+) {
+    for_each_batch!(manifolds, points, states, |m, pair, points, _states| {
         for p in points.iter() {
             pair.apply_normal(p, p.normal_impulse);
             if m.friction {
@@ -226,7 +307,7 @@ const DISK_PROJECTION_ITERATIONS: usize = 4;
 /// the rotational terms make K anisotropic (at a box's corners) it turns the friction away from
 /// −v_t, and a box sliding on the ground felt only 0.936·μ.
 #[inline(always)]
-fn solve_friction(pair: &mut Pair, p: &mut PointLanes) {
+fn solve_friction<F: Lane>(pair: &mut Pair<F>, p: &mut PointLanes<F>) {
     let dv = pair.relative_velocity(p);
     let (vt1, vt2) = (dv.dot(p.tangent1), dv.dot(p.tangent2));
     let [k0, k1, k2] = p.tangent_mass;
@@ -239,11 +320,11 @@ fn solve_friction(pair: &mut Pair, p: &mut PointLanes) {
     if over.any() {
         // Most lanes over the limit have none (no normal impulse: a speculative contact, an
         // unloaded corner) and simply get no friction; the projection is for the others.
-        if (over & limit.cmpgt(F8::ZERO)).any() {
+        if (over & limit.cmpgt(F::ZERO)).any() {
             [new1, new2] = project_to_disk(p.tangent_mass, [new1, new2], limit, over);
         } else {
-            new1 = F8::select(over, F8::ZERO, new1);
-            new2 = F8::select(over, F8::ZERO, new2);
+            new1 = F::select(over, F::ZERO, new1);
+            new2 = F::select(over, F::ZERO, new2);
         }
     }
     p.tangent_impulse = [new1, new2];
@@ -255,18 +336,18 @@ fn solve_friction(pair: &mut Pair, p: &mut PointLanes) {
 /// other lanes keep `target`. Lanes whose K⁻¹ is singular fall back to scaling `target` onto
 /// the disk. The result is scaled onto the circle exactly, so |λ| ≤ r holds to rounding.
 #[inline(always)]
-fn project_to_disk(inv_k: [F8; 3], target: [F8; 2], r: F8, over: super::lanes::M8) -> [F8; 2] {
+fn project_to_disk<F: Lane>(inv_k: [F; 3], target: [F; 2], r: F, over: F::Mask) -> [F; 2] {
     let [a, b, c] = inv_k;
     let det_inv = a * c - b * b;
-    let invertible = det_inv.cmpgt(F8::ZERO);
-    let scale = F8::select(invertible, det_inv.recip(), F8::ZERO);
+    let invertible = det_inv.cmpgt(F::ZERO);
+    let scale = F::select(invertible, det_inv.recip(), F::ZERO);
     // K = (K⁻¹)⁻¹.
     let (k11, k12, k22) = (c * scale, -b * scale, a * scale);
     // b = K·target: the right-hand side of (K + νI)·λ = K·target.
     let rhs1 = k11 * target[0] + k12 * target[1];
     let rhs2 = k12 * target[0] + k22 * target[1];
     let inv_r = r.recip();
-    let mut nu = F8::ZERO;
+    let mut nu = F::ZERO;
     for _ in 0..DISK_PROJECTION_ITERATIONS {
         let (m11, m22) = (k11 + nu, k22 + nu);
         let inv_det = (m11 * m22 - k12 * k12).recip();
@@ -284,7 +365,7 @@ fn project_to_disk(inv_k: [F8; 3], target: [F8; 2], r: F8, over: super::lanes::M
         // ψ(ν) = 1/|λ| − 1/r, ψ'(ν) = −(λ·dλ/dν)/|λ|³.
         let psi = len.recip() - inv_r;
         let dpsi = -(lambda[0] * d[0] + lambda[1] * d[1]) / (len_sq * len);
-        nu = (nu - psi / dpsi).max(F8::ZERO);
+        nu = (nu - psi / dpsi).max(F::ZERO);
     }
     let (m11, m22) = (k11 + nu, k22 + nu);
     let inv_det = (m11 * m22 - k12 * k12).recip();
@@ -298,10 +379,10 @@ fn project_to_disk(inv_k: [F8; 3], target: [F8; 2], r: F8, over: super::lanes::M
     let target_len = (target[0] * target[0] + target[1] * target[1]).sqrt();
     let scaled = [target[0] * (r / target_len), target[1] * (r / target_len)];
     let usable = invertible
-        & len.cmpgt(F8::ZERO)
+        & len.cmpgt(F::ZERO)
         & projected[0].is_finite_mask()
         & projected[1].is_finite_mask();
-    let pick = |i: usize| F8::select(over, F8::select(usable, projected[i], scaled[i]), target[i]);
+    let pick = |i: usize| F::select(over, F::select(usable, projected[i], scaled[i]), target[i]);
     [pick(0), pick(1)]
 }
 
@@ -322,10 +403,10 @@ struct Pass {
 /// In the relax pass the contacts are rigid and unbiased; otherwise each uses its own
 /// softness and pushes overlap out at most at the pass's push-out speed.
 #[inline(always)]
-fn solve_batch(
-    m: &ManifoldLanes,
-    pair: &mut Pair,
-    points: &mut [PointLanes],
+fn solve_batch<F: Lane>(
+    m: &ManifoldLanes<F>,
+    pair: &mut Pair<F>,
+    points: &mut [PointLanes<F>],
     states: &[BodyState],
     pass: Pass,
 ) {
@@ -336,27 +417,23 @@ fn solve_batch(
         friction,
     } = pass;
     let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
-    let inv_h = F8::splat(inv_h);
-    let push_out = F8::splat(-max_push_out);
+    let inv_h = F::splat(inv_h);
+    let push_out = F::splat(-max_push_out);
     for p in points.iter_mut() {
         let s = separation(p, &motion_a, &motion_b);
-        let speculative = s.cmpgt(F8::ZERO);
+        let speculative = s.cmpgt(F::ZERO);
         let (bias, mass_scale, impulse_scale) = if relax {
-            (
-                F8::select(speculative, s * inv_h, F8::ZERO),
-                F8::ONE,
-                F8::ZERO,
-            )
+            (F::select(speculative, s * inv_h, F::ZERO), F::ONE, F::ZERO)
         } else {
             (
-                F8::select(speculative, s * inv_h, (p.bias_rate * s).max(push_out)),
-                F8::select(speculative, F8::ONE, p.mass_scale),
-                F8::select(speculative, F8::ZERO, p.impulse_scale),
+                F::select(speculative, s * inv_h, (p.bias_rate * s).max(push_out)),
+                F::select(speculative, F::ONE, p.mass_scale),
+                F::select(speculative, F::ZERO, p.impulse_scale),
             )
         };
         let vn = pair.relative_velocity(p).dot(p.normal);
         let delta = -p.normal_mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
-        let total = (p.normal_impulse + delta).max(F8::ZERO);
+        let total = (p.normal_impulse + delta).max(F::ZERO);
         let delta = total - p.normal_impulse;
         p.normal_impulse = total;
         p.max_normal_impulse = p.max_normal_impulse.max(delta);
@@ -368,14 +445,15 @@ fn solve_batch(
 }
 
 #[inline(always)]
-fn solve_impl(
-    batches: &mut Batches,
+fn solve_impl<F: Lane>(
+    manifolds: &[ManifoldLanes<F>],
+    points: &mut [PointLanes<F>],
     states: &mut [BodyState],
     inv_h: f32,
     max_push_out: f32,
     friction: bool,
 ) {
-    for_each_batch!(batches, states, |m, pair, points, states| {
+    for_each_batch!(manifolds, points, states, |m, pair, points, states| {
         let pass = Pass {
             inv_h,
             max_push_out,
@@ -394,8 +472,13 @@ wide_kernel! {
 }
 
 #[inline(always)]
-fn relax_impl(batches: &mut Batches, states: &mut [BodyState], inv_h: f32) {
-    for_each_batch!(batches, states, |m, pair, points, states| {
+fn relax_impl<F: Lane>(
+    manifolds: &[ManifoldLanes<F>],
+    points: &mut [PointLanes<F>],
+    states: &mut [BodyState],
+    inv_h: f32,
+) {
+    for_each_batch!(manifolds, points, states, |m, pair, points, states| {
         let pass = Pass {
             inv_h,
             max_push_out: 0.0,
@@ -450,7 +533,10 @@ pub fn restitution(
     let mut largest = F8::ZERO;
     let threshold = F8::splat(threshold);
     let inv_h = F8::splat(inv_h);
-    for_each_batch!(batches, states, |m, pair, points, states| {
+    let Batches {
+        manifolds, points, ..
+    } = batches;
+    for_each_batch!(manifolds, points, states, |m, pair, points, states| {
         let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
         for p in points.iter_mut() {
             let vn = pair.relative_velocity(p).dot(p.normal);
@@ -506,5 +592,86 @@ pub fn results(
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::soft_step::{PrepareParams, Softness};
+    use crate::synthetic::{self, DT, GRAVITY};
+
+    /// A random pile packed for the kernels, and its body states after a substep of gravity.
+    fn pile() -> (Batches, Vec<BodyState>) {
+        let scene = synthetic::random_pile(2000, 7);
+        let h = DT / 4.0;
+        let s = Softness::new(30.0, 10.0, h);
+        let params = PrepareParams {
+            static_softness: Softness::new(60.0, 10.0, h),
+            dynamic_softness: s,
+            warm_scale: 0.25,
+        };
+        let mut batches = Batches::default();
+        batches.pack(&scene.contacts, &scene.bodies, 0.02, &params);
+        let mut states: Vec<BodyState> = scene.bodies.iter().map(BodyState::from_body).collect();
+        states[0] = BodyState::STATIC;
+        for s in states.iter_mut().skip(1) {
+            s.linear_velocity += GRAVITY * h;
+            s.delta_position = s.linear_velocity * h;
+        }
+        (batches, states)
+    }
+
+    fn bits(states: &[BodyState], batches: &Batches) -> Vec<u32> {
+        let mut out = Vec::new();
+        for s in states {
+            for v in [s.linear_velocity, s.angular_velocity] {
+                out.extend(v.to_array().map(f32::to_bits));
+            }
+        }
+        for p in &batches.points {
+            for l in 0..LANES {
+                out.push(p.normal_impulse[l].to_bits());
+                out.push(p.tangent_impulse[0][l].to_bits());
+                out.push(p.tangent_impulse[1][l].to_bits());
+            }
+        }
+        out
+    }
+
+    /// The public kernels take the 256-bit path on CPUs with AVX; their results must equal the
+    /// 128-bit kernels' bit for bit (on a CPU without AVX both are the 128-bit kernels).
+    #[test]
+    fn the_wide_kernels_match_the_128_bit_ones_bit_for_bit() {
+        let (mut batches, mut states) = pile();
+        assert!(batches.contacts > 1000);
+        let (mut narrow_batches, mut narrow_states) = (batches.clone(), states.clone());
+        let inv_h = 4.0 / DT;
+
+        warm_start(&mut batches, &mut states);
+        solve(&mut batches, &mut states, inv_h, 3.0, false);
+        relax(&mut batches, &mut states, inv_h);
+
+        let Batches {
+            manifolds, points, ..
+        } = &mut narrow_batches;
+        warm_start_impl::<F8>(manifolds, points, &mut narrow_states);
+        solve_impl::<F8>(manifolds, points, &mut narrow_states, inv_h, 3.0, false);
+        relax_impl::<F8>(manifolds, points, &mut narrow_states, inv_h);
+
+        let (wide, narrow) = (
+            bits(&states, &batches),
+            bits(&narrow_states, &narrow_batches),
+        );
+        assert_eq!(wide.len(), narrow.len());
+        let differing = wide.iter().zip(&narrow).filter(|(a, b)| a != b).count();
+        assert_eq!(differing, 0, "{differing} of {} values differ", wide.len());
+        // The passes did real work.
+        assert!(
+            narrow_batches
+                .points
+                .iter()
+                .any(|p| p.normal_impulse.max_element() > 0.0)
+        );
     }
 }

@@ -1,0 +1,170 @@
+//! Eight `f32` lanes in one 256-bit AVX register, for the kernels compiled for AVX.
+//!
+//! [`W8`] is the [`Lane`] type the soft-step kernels use inside functions compiled with
+//! `#[target_feature(enable = "avx")]` (or AVX-512VL), which run only after the CPU has been
+//! detected to support them ([`super::solve`]). One instruction per operation instead of
+//! [`F8`]'s two. Its layout is [`F8`]'s (32 bytes, aligned to 32), so a batch prepared with
+//! [`F8`] is read as [`W8`] in place. Every operation is the same lane-wise IEEE operation as
+//! [`F8`]'s (`maxps` semantics for the maximum, ordered comparisons, exact division and square
+//! root, no fused multiply-add), so both give bit-identical results.
+//!
+//! The intrinsics need AVX. The type is private to the soft-step module and its values exist
+//! only inside the AVX kernels, where every operation is inlined into code compiled for AVX.
+
+// SAFETY (every `unsafe` block of this file): the AVX intrinsics are sound on a CPU with AVX,
+// and `W8`/`WM8` values are only created and used inside the AVX kernels of `super::solve`,
+// which are entered only after `is_x86_feature_detected!("avx")` (or "avx512vl") returned true.
+use super::lanes::{F8, Lane, LaneMask, WIDTH};
+use std::arch::x86_64::*;
+use std::ops::{Add, BitAnd, BitOr, Div, Index, IndexMut, Mul, Neg, Sub};
+
+/// Eight `f32` lanes in one AVX register.
+#[derive(Clone, Copy)]
+#[repr(C, align(32))]
+pub struct W8(__m256);
+
+/// Eight-lane mask: all bits set in a lane that holds.
+#[derive(Clone, Copy)]
+#[repr(C, align(32))]
+pub struct WM8(__m256);
+
+const _: () = assert!(size_of::<W8>() == size_of::<F8>() && align_of::<W8>() == align_of::<F8>());
+
+macro_rules! binary {
+    ($tr:ident, $f:ident, $intrinsic:ident) => {
+        impl $tr for W8 {
+            type Output = Self;
+            #[inline(always)]
+            fn $f(self, o: Self) -> Self {
+                // SAFETY: see the file header.
+                unsafe { W8($intrinsic(self.0, o.0)) }
+            }
+        }
+    };
+}
+binary!(Add, add, _mm256_add_ps);
+binary!(Sub, sub, _mm256_sub_ps);
+binary!(Mul, mul, _mm256_mul_ps);
+binary!(Div, div, _mm256_div_ps);
+
+impl Neg for W8 {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        // SAFETY: see the file header.
+        unsafe { W8(_mm256_xor_ps(self.0, _mm256_set1_ps(-0.0))) }
+    }
+}
+
+impl Index<usize> for W8 {
+    type Output = f32;
+    #[inline(always)]
+    fn index(&self, i: usize) -> &f32 {
+        // SAFETY: `W8` is 32 bytes of eight f32 lanes, with no invalid bit patterns.
+        let lanes = unsafe { &*(self as *const W8 as *const [f32; WIDTH]) };
+        &lanes[i]
+    }
+}
+
+impl IndexMut<usize> for W8 {
+    #[inline(always)]
+    fn index_mut(&mut self, i: usize) -> &mut f32 {
+        // SAFETY: as for `index`.
+        let lanes = unsafe { &mut *(self as *mut W8 as *mut [f32; WIDTH]) };
+        &mut lanes[i]
+    }
+}
+
+macro_rules! compare {
+    ($name:ident, $predicate:ident) => {
+        #[inline(always)]
+        fn $name(self, o: Self) -> WM8 {
+            // SAFETY: see the file header.
+            unsafe { WM8(_mm256_cmp_ps::<$predicate>(self.0, o.0)) }
+        }
+    };
+}
+
+impl Lane for W8 {
+    type Mask = WM8;
+    // SAFETY: plain bit patterns (eight 0.0 or 1.0 lanes); no intrinsic runs.
+    const ZERO: Self = unsafe { std::mem::transmute::<[f32; WIDTH], W8>([0.0; WIDTH]) };
+    // SAFETY: as for ZERO.
+    const ONE: Self = unsafe { std::mem::transmute::<[f32; WIDTH], W8>([1.0; WIDTH]) };
+
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        // SAFETY: see the file header.
+        unsafe { W8(_mm256_set1_ps(x)) }
+    }
+
+    #[inline(always)]
+    fn select(mask: WM8, t: Self, f: Self) -> Self {
+        // SAFETY: see the file header.
+        unsafe { W8(_mm256_blendv_ps(f.0, t.0, mask.0)) }
+    }
+
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        // SAFETY: see the file header. `vmaxps` returns the second operand when either is NaN,
+        // as SSE's `maxps` does for `F8`.
+        unsafe { W8(_mm256_max_ps(self.0, o.0)) }
+    }
+
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        // SAFETY: see the file header.
+        unsafe { W8(_mm256_sqrt_ps(self.0)) }
+    }
+
+    #[inline(always)]
+    fn recip(self) -> Self {
+        // SAFETY: see the file header. Exact division, as glam's `Vec4::recip`.
+        unsafe { W8(_mm256_div_ps(_mm256_set1_ps(1.0), self.0)) }
+    }
+
+    #[inline(always)]
+    fn abs(self) -> Self {
+        // SAFETY: see the file header.
+        unsafe { W8(_mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0)) }
+    }
+
+    #[inline(always)]
+    fn is_finite_mask(self) -> WM8 {
+        // |x| < ∞, as glam's `Vec4::is_finite_mask`.
+        self.abs().cmplt(W8::splat(f32::INFINITY))
+    }
+
+    // SSE's `cmpgt`/`cmplt`/`cmple` are the signalling ordered predicates, `cmpeq` the quiet
+    // ordered one; the masks they give are the same for every input.
+    compare!(cmpgt, _CMP_GT_OS);
+    compare!(cmplt, _CMP_LT_OS);
+    compare!(cmple, _CMP_LE_OS);
+    compare!(cmpeq, _CMP_EQ_OQ);
+}
+
+impl BitAnd for WM8 {
+    type Output = Self;
+    #[inline(always)]
+    fn bitand(self, o: Self) -> Self {
+        // SAFETY: see the file header.
+        unsafe { WM8(_mm256_and_ps(self.0, o.0)) }
+    }
+}
+
+impl BitOr for WM8 {
+    type Output = Self;
+    #[inline(always)]
+    fn bitor(self, o: Self) -> Self {
+        // SAFETY: see the file header.
+        unsafe { WM8(_mm256_or_ps(self.0, o.0)) }
+    }
+}
+
+impl LaneMask for WM8 {
+    #[inline(always)]
+    fn any(self) -> bool {
+        // SAFETY: see the file header.
+        unsafe { _mm256_movemask_ps(self.0) != 0 }
+    }
+}
