@@ -20,7 +20,7 @@
 //! entry, so every impulse they compute is exactly zero.
 
 use super::lanes::{F8, V3x8, WIDTH};
-use super::prepare::{BodyLanes, PrepareParams, prepare_point};
+use super::prepare::{PrepareParams, prepare_batches};
 use crate::{Contact, STATIC_BODY, SolverBody};
 
 /// Manifolds per batch: the lane count of [`super::lanes`].
@@ -35,7 +35,7 @@ const COLOURS: u32 = 64;
 /// Marks a lane-point that holds no contact.
 pub const NO_SOURCE: u32 = u32::MAX;
 
-/// One contact point of each of eight manifolds, stored by lane, as [`prepare_point`] computes
+/// One contact point of each of eight manifolds, stored by lane, as [`prepare_point`](super::prepare::prepare_point) computes
 /// it; a padding lane holds zeros.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C)]
@@ -266,19 +266,22 @@ impl Batches {
             for (l, run) in batch_runs.iter_mut().enumerate().take(lanes) {
                 *run = self.runs[self.order[k + l] as usize];
             }
-            self.push_batch(&batch_runs[..lanes], contacts, bodies, params);
+            self.push_batch(&batch_runs[..lanes], contacts);
             k += lanes;
         }
+        prepare_batches(
+            &mut self.manifolds,
+            &mut self.points,
+            &self.sources,
+            contacts,
+            bodies,
+            params,
+        );
     }
 
-    /// Appends one batch holding `runs` (at most [`LANES`]) in lanes 0, 1, ...
-    fn push_batch(
-        &mut self,
-        runs: &[Run],
-        contacts: &[Contact],
-        bodies: &[SolverBody],
-        params: &PrepareParams,
-    ) {
+    /// Appends one batch holding `runs` (at most [`LANES`]) in lanes 0, 1, ...: its bodies,
+    /// its points' sources and zeroed points, which [`prepare_batches`] fills.
+    fn push_batch(&mut self, runs: &[Run], contacts: &[Contact]) {
         debug_assert!(!runs.is_empty() && runs.len() <= LANES);
         let count = runs.iter().map(|r| r.len).max().unwrap_or(0);
         let first = self.points.len() as u32;
@@ -288,31 +291,25 @@ impl Batches {
             let c0 = &contacts[self.kept[r.start as usize] as usize];
             (a[lane], b[lane]) = (c0.a, c0.b);
         }
-        let (body_a, body_b) = (BodyLanes::gather(bodies, a), BodyLanes::gather(bodies, b));
         let mut friction = false;
         self.points
             .resize(first as usize + count as usize, PointLanes::default());
         for p in 0..count {
             let mut source = [NO_SOURCE; LANES];
-            let mut lane_contacts: [Option<&Contact>; LANES] = [None; LANES];
             for (lane, r) in runs.iter().enumerate() {
                 if p < r.len {
                     let i = self.kept[(r.start + p) as usize];
                     source[lane] = i;
-                    let c = &contacts[i as usize];
-                    friction |= c.friction > 0.0;
-                    lane_contacts[lane] = Some(c);
+                    friction |= contacts[i as usize].friction > 0.0;
                 }
             }
-            let out = &mut self.points[(first + p) as usize];
-            prepare_point(out, lane_contacts, &body_a, &body_b, params);
             self.sources.push(source);
         }
         self.manifolds.push(ManifoldLanes {
             a,
             b,
-            inv_mass_a: body_a.inv_mass,
-            inv_mass_b: body_b.inv_mass,
+            inv_mass_a: F8::ZERO,
+            inv_mass_b: F8::ZERO,
             first,
             count,
             friction,

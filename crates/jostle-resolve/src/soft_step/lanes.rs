@@ -210,6 +210,8 @@ pub trait Lane:
     const ONE: Self;
     /// All lanes `x`.
     fn splat(x: f32) -> Self;
+    /// Lane i from `a[i]`.
+    fn from_array(a: [f32; WIDTH]) -> Self;
     /// Lane-wise `if mask { t } else { f }`.
     fn select(mask: Self::Mask, t: Self, f: Self) -> Self;
     /// Lane-wise maximum: `self` where it is greater, else `o` (so `o` when either is NaN,
@@ -246,6 +248,10 @@ impl Lane for F8 {
     #[inline(always)]
     fn splat(x: f32) -> Self {
         F8::splat(x)
+    }
+    #[inline(always)]
+    fn from_array(a: [f32; WIDTH]) -> Self {
+        F8::from_array(a)
     }
     #[inline(always)]
     fn select(mask: M8, t: Self, f: Self) -> Self {
@@ -308,19 +314,17 @@ pub struct V3x8<F = F8> {
     pub z: F,
 }
 
-impl V3x8 {
+impl<F: Lane> V3x8<F> {
     /// Packs eight vectors, lane i from `v[i]`.
     #[inline(always)]
     pub fn from_lanes(v: [Vec3; WIDTH]) -> Self {
         Self {
-            x: F8::from_array(v.map(|v| v.x)),
-            y: F8::from_array(v.map(|v| v.y)),
-            z: F8::from_array(v.map(|v| v.z)),
+            x: F::from_array(v.map(|v| v.x)),
+            y: F::from_array(v.map(|v| v.y)),
+            z: F::from_array(v.map(|v| v.z)),
         }
     }
-}
 
-impl<F: Lane> V3x8<F> {
     /// All lanes zero.
     pub const ZERO: Self = Self {
         x: F::ZERO,
@@ -457,7 +461,7 @@ mod tests {
     fn lane_operations_match_the_scalar_ones() {
         let a = lanes();
         let b = a.map(|v| Vec3::new(v.z, -v.x, v.y * 0.5));
-        let (wa, wb) = (V3x8::from_lanes(a), V3x8::from_lanes(b));
+        let (wa, wb) = (V3x8::<F8>::from_lanes(a), V3x8::<F8>::from_lanes(b));
         for i in 0..WIDTH {
             assert_eq!(wa.dot(wb)[i], a[i].dot(b[i]));
             assert_eq!(wa.cross(wb).lane(i), a[i].cross(b[i]));
@@ -475,7 +479,7 @@ mod tests {
             ),
         });
         let r = lanes();
-        let mut packed = Q8::IDENTITY;
+        let mut packed = Q8::<F8>::IDENTITY;
         for (i, q) in q.iter().enumerate() {
             packed.set_lane(i, *q);
         }

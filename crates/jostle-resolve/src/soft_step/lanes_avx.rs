@@ -14,6 +14,7 @@
 // SAFETY (every `unsafe` block of this file): the AVX intrinsics are sound on a CPU with AVX,
 // and `W8`/`WM8` values are only created and used inside the AVX kernels of `super::solve`,
 // which are entered only after `is_x86_feature_detected!("avx")` (or "avx512vl") returned true.
+use super::batch::{ManifoldLanes, PointLanes};
 use super::lanes::{F8, Lane, LaneMask, WIDTH};
 use std::arch::x86_64::*;
 use std::ops::{Add, BitAnd, BitOr, Div, Index, IndexMut, Mul, Neg, Sub};
@@ -99,6 +100,12 @@ impl Lane for W8 {
     }
 
     #[inline(always)]
+    fn from_array(a: [f32; WIDTH]) -> Self {
+        // SAFETY: see the file header; an unaligned load of eight f32.
+        unsafe { W8(_mm256_loadu_ps(a.as_ptr())) }
+    }
+
+    #[inline(always)]
     fn select(mask: WM8, t: Self, f: Self) -> Self {
         // SAFETY: see the file header.
         unsafe { W8(_mm256_blendv_ps(f.0, t.0, mask.0)) }
@@ -166,5 +173,52 @@ impl LaneMask for WM8 {
     fn any(self) -> bool {
         // SAFETY: see the file header.
         unsafe { _mm256_movemask_ps(self.0) != 0 }
+    }
+}
+
+/// Which 256-bit kernels the CPU can run.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum AvxLevel {
+    /// AVX-512F and AVX-512VL: 256-bit lanes and 32 vector registers.
+    Avx512,
+    /// AVX: 256-bit lanes, 16 registers.
+    Avx,
+    /// Neither: the 128-bit kernels.
+    None,
+}
+
+pub(super) fn avx_level() -> AvxLevel {
+    if std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512vl")
+    {
+        AvxLevel::Avx512
+    } else if std::arch::is_x86_feature_detected!("avx") {
+        AvxLevel::Avx
+    } else {
+        AvxLevel::None
+    }
+}
+
+const _: () = {
+    assert!(size_of::<PointLanes<W8>>() == size_of::<PointLanes<F8>>());
+    assert!(align_of::<PointLanes<W8>>() == align_of::<PointLanes<F8>>());
+    assert!(size_of::<ManifoldLanes<W8>>() == size_of::<ManifoldLanes<F8>>());
+    assert!(align_of::<ManifoldLanes<W8>>() == align_of::<ManifoldLanes<F8>>());
+};
+
+/// The batches viewed with [`W8`] lanes.
+#[inline(always)]
+pub(super) fn as_wide<'a>(
+    manifolds: &'a mut [ManifoldLanes<F8>],
+    points: &'a mut [PointLanes<F8>],
+) -> (&'a mut [ManifoldLanes<W8>], &'a mut [PointLanes<W8>]) {
+    // SAFETY: `ManifoldLanes` and `PointLanes` are `repr(C)`, and `W8` has `F8`'s size and
+    // alignment (asserted above), so both instantiations have the same
+    // layout; every bit pattern is a valid `W8`. The borrows are carried over unchanged.
+    unsafe {
+        (
+            std::slice::from_raw_parts_mut(manifolds.as_mut_ptr().cast(), manifolds.len()),
+            std::slice::from_raw_parts_mut(points.as_mut_ptr().cast(), points.len()),
+        )
     }
 }

@@ -13,11 +13,11 @@
 //! during the step is that plus (Δx_A + Δq_A·r_A − Δx_B − Δq_B·r_B)·n (Box2D's "adjusted
 //! separation"; see [`super::solve`]).
 
-use super::batch::PointLanes;
-use super::lanes::{F8, V3x8, WIDTH};
+use super::batch::{LANES, ManifoldLanes, NO_SOURCE, PointLanes};
+use super::lanes::{F8, Lane, V3x8, WIDTH};
 use super::softness::Softness;
 use crate::{Contact, SolverBody};
-use jostle_math::{Mat3, contact_basis};
+use jostle_math::{Mat3, Vec3, contact_basis};
 
 /// What [`prepare_point`] needs besides the contact and its bodies.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -32,18 +32,19 @@ pub struct PrepareParams {
 
 /// The step-start state of eight bodies, by lane, as preparation reads it.
 #[derive(Clone, Copy, Debug)]
-pub struct BodyLanes {
-    position: V3x8,
-    linear_velocity: V3x8,
-    angular_velocity: V3x8,
+pub struct BodyLanes<F = F8> {
+    position: V3x8<F>,
+    linear_velocity: V3x8<F>,
+    angular_velocity: V3x8<F>,
     /// Columns of the world inverse inertia (zero for a body that does not rotate).
-    inv_inertia: [V3x8; 3],
+    inv_inertia: [V3x8<F>; 3],
     /// 1/m (1/kg).
-    pub inv_mass: F8,
+    pub inv_mass: F,
 }
 
-impl BodyLanes {
+impl<F: Lane> BodyLanes<F> {
     /// Loads `bodies[idx[lane]]` into each lane.
+    #[inline(always)]
     pub fn gather(bodies: &[SolverBody], idx: [u32; WIDTH]) -> Self {
         let b = idx.map(|i| &bodies[i as usize]);
         let inertia = b.map(|b| {
@@ -62,20 +63,20 @@ impl BodyLanes {
                 V3x8::from_lanes(inertia.map(|m| m.y_axis)),
                 V3x8::from_lanes(inertia.map(|m| m.z_axis)),
             ],
-            inv_mass: F8::from_array(b.map(|b| b.inv_mass)),
+            inv_mass: F::from_array(b.map(|b| b.inv_mass)),
         }
     }
 
     /// I⁻¹·v per lane.
-    #[inline]
-    fn inv_inertia_times(&self, v: V3x8) -> V3x8 {
+    #[inline(always)]
+    fn inv_inertia_times(&self, v: V3x8<F>) -> V3x8<F> {
         let [x, y, z] = self.inv_inertia;
         x * v.x + y * v.y + z * v.z
     }
 
     /// Velocity of each lane's material point at offset `r` from its centre of mass.
-    #[inline]
-    fn velocity_at(&self, r: V3x8) -> V3x8 {
+    #[inline(always)]
+    fn velocity_at(&self, r: V3x8<F>) -> V3x8<F> {
         self.linear_velocity + self.angular_velocity.cross(r)
     }
 }
@@ -83,34 +84,42 @@ impl BodyLanes {
 /// Prepares one point of eight lanes into `out`: `contacts[lane]` between the bodies of lane `lane` in
 /// `a` and `b`. Lanes whose contact is `None` are padding and get zeros (zero normal, zero
 /// masses), so every impulse they compute is zero.
-pub fn prepare_point(
-    out: &mut PointLanes,
+#[inline(always)]
+pub fn prepare_point<F: Lane>(
+    out: &mut PointLanes<F>,
     contacts: [Option<&Contact>; WIDTH],
-    a: &BodyLanes,
-    b: &BodyLanes,
+    a: &BodyLanes<F>,
+    b: &BodyLanes<F>,
     params: &PrepareParams,
 ) {
-    let mut n = V3x8::ZERO;
-    let mut t1 = V3x8::ZERO;
-    let mut t2 = V3x8::ZERO;
-    let mut point = V3x8::ZERO;
-    let mut stored = V3x8::ZERO;
+    // Lane by lane into arrays, then one load per component (writing lanes of a vector one
+    // at a time would stall the load that follows on every store).
+    let mut vectors = [[Vec3::ZERO; WIDTH]; 5];
     let mut penetration = [0.0; WIDTH];
     let mut friction = [0.0; WIDTH];
     let mut restitution = [0.0; WIDTH];
     for (lane, c) in contacts.iter().enumerate() {
         if let Some(c) = c {
             let basis = contact_basis(c.normal);
-            n.set_lane(lane, basis.x_axis);
-            t1.set_lane(lane, basis.y_axis);
-            t2.set_lane(lane, basis.z_axis);
-            point.set_lane(lane, c.point);
-            stored.set_lane(lane, c.impulse);
+            vectors[0][lane] = basis.x_axis;
+            vectors[1][lane] = basis.y_axis;
+            vectors[2][lane] = basis.z_axis;
+            vectors[3][lane] = c.point;
+            vectors[4][lane] = c.impulse;
             penetration[lane] = c.penetration;
             friction[lane] = c.friction;
             restitution[lane] = c.restitution;
         }
     }
+    // No closures over lanes here or below: a closure is not compiled with the target
+    // features of the kernel it sits in, so every lane operation in it would be a call.
+    let [n, t1, t2, point, stored] = [
+        V3x8::<F>::from_lanes(vectors[0]),
+        V3x8::from_lanes(vectors[1]),
+        V3x8::from_lanes(vectors[2]),
+        V3x8::from_lanes(vectors[3]),
+        V3x8::from_lanes(vectors[4]),
+    ];
     let r_a = point - a.position;
     let r_b = point - b.position;
     let m = a.inv_mass + b.inv_mass;
@@ -119,29 +128,27 @@ pub fn prepare_point(
     let ang_a_normal = a.inv_inertia_times(rn_a);
     let ang_b_normal = b.inv_inertia_times(rn_b);
     let k_normal = m + rn_a.dot(ang_a_normal) + rn_b.dot(ang_b_normal);
-    let normal_mass = F8::select(k_normal.cmpgt(F8::ZERO), k_normal.recip(), F8::ZERO);
+    let normal_mass = F::select(k_normal.cmpgt(F::ZERO), k_normal.recip(), F::ZERO);
 
     let rt_a = [r_a.cross(t1), r_a.cross(t2)];
     let rt_b = [r_b.cross(t1), r_b.cross(t2)];
-    let ang_a_tangent = rt_a.map(|v| a.inv_inertia_times(v));
-    let ang_b_tangent = rt_b.map(|v| b.inv_inertia_times(v));
-    let k = |i: usize, j: usize| {
-        let diag = if i == j { m } else { F8::ZERO };
-        diag + rt_a[i].dot(ang_a_tangent[j]) + rt_b[i].dot(ang_b_tangent[j])
-    };
-    let (k11, k12, k22) = (k(0, 0), k(0, 1), k(1, 1));
+    let ang_a_tangent = [a.inv_inertia_times(rt_a[0]), a.inv_inertia_times(rt_a[1])];
+    let ang_b_tangent = [b.inv_inertia_times(rt_b[0]), b.inv_inertia_times(rt_b[1])];
+    // K = m·I + Σ (r × tᵢ)·I⁻¹·(r × tⱼ) over both bodies, symmetric.
+    let k11 = m + rt_a[0].dot(ang_a_tangent[0]) + rt_b[0].dot(ang_b_tangent[0]);
+    let k12 = F::ZERO + rt_a[0].dot(ang_a_tangent[1]) + rt_b[0].dot(ang_b_tangent[1]);
+    let k22 = m + rt_a[1].dot(ang_a_tangent[1]) + rt_b[1].dot(ang_b_tangent[1]);
     let det = k11 * k22 - k12 * k12;
-    let invertible = det.cmpgt(F8::splat(f32::EPSILON) * k11 * k22) & det.is_finite_mask();
-    let inv_det = F8::select(invertible, det.recip(), F8::ZERO);
+    let invertible = det.cmpgt(F::splat(f32::EPSILON) * k11 * k22) & det.is_finite_mask();
+    let inv_det = F::select(invertible, det.recip(), F::ZERO);
     let tangent_mass = [k22 * inv_det, -k12 * inv_det, k11 * inv_det];
 
-    let fixed = a.inv_mass.cmpeq(F8::ZERO) | b.inv_mass.cmpeq(F8::ZERO);
+    let fixed = a.inv_mass.cmpeq(F::ZERO) | b.inv_mass.cmpeq(F::ZERO);
     let (s, d) = (params.static_softness, params.dynamic_softness);
-    let soft = |fs: f32, fd: f32| F8::select(fixed, F8::splat(fs), F8::splat(fd));
 
-    let friction = F8::from_array(friction).max(F8::ZERO);
-    let warm = stored * F8::splat(params.warm_scale);
-    let has_friction = friction.cmpgt(F8::ZERO);
+    let friction = F::from_array(friction).max(F::ZERO);
+    let warm = stored * F::splat(params.warm_scale);
+    let has_friction = friction.cmpgt(F::ZERO);
     let dv = a.velocity_at(r_a) - b.velocity_at(r_b);
     *out = PointLanes {
         normal: n,
@@ -149,13 +156,13 @@ pub fn prepare_point(
         r_b,
         ang_a_normal,
         ang_b_normal,
-        base_separation: -F8::from_array(penetration) - (r_a - r_b).dot(n),
+        base_separation: -F::from_array(penetration) - (r_a - r_b).dot(n),
         normal_mass,
-        normal_impulse: warm.x.max(F8::ZERO),
-        max_normal_impulse: F8::ZERO,
-        bias_rate: soft(s.bias_rate, d.bias_rate),
-        mass_scale: soft(s.mass_scale, d.mass_scale),
-        impulse_scale: soft(s.impulse_scale, d.impulse_scale),
+        normal_impulse: warm.x.max(F::ZERO),
+        max_normal_impulse: F::ZERO,
+        bias_rate: F::select(fixed, F::splat(s.bias_rate), F::splat(d.bias_rate)),
+        mass_scale: F::select(fixed, F::splat(s.mass_scale), F::splat(d.mass_scale)),
+        impulse_scale: F::select(fixed, F::splat(s.impulse_scale), F::splat(d.impulse_scale)),
         friction,
         tangent1: t1,
         tangent2: t2,
@@ -165,10 +172,122 @@ pub fn prepare_point(
         ang_b_tangent2: ang_b_tangent[1],
         tangent_mass,
         tangent_impulse: [
-            F8::select(has_friction, warm.y, F8::ZERO),
-            F8::select(has_friction, warm.z, F8::ZERO),
+            F::select(has_friction, warm.y, F::ZERO),
+            F::select(has_friction, warm.z, F::ZERO),
         ],
-        restitution: F8::from_array(restitution),
+        restitution: F::from_array(restitution),
         relative_velocity: dv.dot(n),
     };
+}
+
+/// Prepares every point of the packed batches: for each batch, its bodies are gathered once
+/// (and their inverse masses stored in the batch), then each point is prepared from the
+/// contacts `sources` names ([`prepare_point`]). On x86-64 CPUs with AVX this runs with
+/// 256-bit lanes, as the kernels do (see [`super::solve`]); the results are the same.
+pub fn prepare_batches(
+    manifolds: &mut [ManifoldLanes],
+    points: &mut [PointLanes],
+    sources: &[[u32; LANES]],
+    contacts: &[Contact],
+    bodies: &[SolverBody],
+    params: &PrepareParams,
+) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use super::lanes_avx::{AvxLevel, W8, as_wide, avx_level};
+        #[target_feature(enable = "avx512f,avx512vl")]
+        fn avx512(
+            manifolds: &mut [ManifoldLanes<W8>],
+            points: &mut [PointLanes<W8>],
+            sources: &[[u32; LANES]],
+            contacts: &[Contact],
+            bodies: &[SolverBody],
+            params: &PrepareParams,
+        ) {
+            prepare_batches_impl(manifolds, points, sources, contacts, bodies, params)
+        }
+        #[target_feature(enable = "avx")]
+        fn avx(
+            manifolds: &mut [ManifoldLanes<W8>],
+            points: &mut [PointLanes<W8>],
+            sources: &[[u32; LANES]],
+            contacts: &[Contact],
+            bodies: &[SolverBody],
+            params: &PrepareParams,
+        ) {
+            prepare_batches_impl(manifolds, points, sources, contacts, bodies, params)
+        }
+        match avx_level() {
+            AvxLevel::Avx512 => {
+                let (manifolds, points) = as_wide(manifolds, points);
+                // SAFETY: the CPU has been detected to support the enabled features.
+                return unsafe { avx512(manifolds, points, sources, contacts, bodies, params) };
+            }
+            AvxLevel::Avx => {
+                let (manifolds, points) = as_wide(manifolds, points);
+                // SAFETY: as above.
+                return unsafe { avx(manifolds, points, sources, contacts, bodies, params) };
+            }
+            AvxLevel::None => {}
+        }
+    }
+    prepare_batches_impl::<F8>(manifolds, points, sources, contacts, bodies, params)
+}
+
+#[inline(always)]
+fn prepare_batches_impl<F: Lane>(
+    manifolds: &mut [ManifoldLanes<F>],
+    points: &mut [PointLanes<F>],
+    sources: &[[u32; LANES]],
+    contacts: &[Contact],
+    bodies: &[SolverBody],
+    params: &PrepareParams,
+) {
+    for m in manifolds.iter_mut() {
+        let a = BodyLanes::<F>::gather(bodies, m.a);
+        let b = BodyLanes::<F>::gather(bodies, m.b);
+        m.inv_mass_a = a.inv_mass;
+        m.inv_mass_b = b.inv_mass;
+        let range = m.first as usize..(m.first + m.count) as usize;
+        for (out, source) in points[range.clone()].iter_mut().zip(&sources[range]) {
+            let lane_contacts = source.map(|i| (i != NO_SOURCE).then(|| &contacts[i as usize]));
+            prepare_point(out, lane_contacts, &a, &b, params);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::soft_step::{Batches, Softness};
+    use crate::synthetic;
+
+    /// `prepare_batches` takes the 256-bit path on CPUs with AVX; what it prepares must equal
+    /// the 128-bit preparation exactly (Debug prints every float in shortest round-trip form,
+    /// signed zeros included).
+    #[test]
+    fn wide_preparation_matches_the_128_bit_one() {
+        let scene = synthetic::random_pile(2000, 11);
+        let h = synthetic::DT / 4.0;
+        let params = PrepareParams {
+            static_softness: Softness::new(60.0, 10.0, h),
+            dynamic_softness: Softness::new(30.0, 10.0, h),
+            warm_scale: 0.25,
+        };
+        let mut batches = Batches::default();
+        batches.pack(&scene.contacts, &scene.bodies, 0.02, &params);
+        assert!(batches.contacts > 1000);
+        let mut manifolds = batches.manifolds.clone();
+        let mut points = vec![PointLanes::default(); batches.points.len()];
+        prepare_batches_impl::<F8>(
+            &mut manifolds,
+            &mut points,
+            &batches.sources,
+            &scene.contacts,
+            &scene.bodies,
+            &params,
+        );
+        assert_eq!(format!("{:?}", batches.points), format!("{points:?}"));
+        assert_eq!(format!("{:?}", batches.manifolds), format!("{manifolds:?}"));
+    }
 }

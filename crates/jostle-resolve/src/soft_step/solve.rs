@@ -176,14 +176,15 @@ macro_rules! wide_kernel {
                 ) -> $ret {
                     $imp(manifolds, points $(, $arg)*)
                 }
+                use super::lanes_avx::{AvxLevel, as_wide, avx_level};
                 match avx_level() {
                     AvxLevel::Avx512 => {
-                        let (manifolds, points) = as_wide(manifolds, points);
+                        let (manifolds, points) = as_wide(&mut manifolds[..], points);
                         // SAFETY: the CPU has been detected to support the enabled features.
                         return unsafe { avx512(manifolds, points $(, $arg)*) };
                     }
                     AvxLevel::Avx => {
-                        let (manifolds, points) = as_wide(manifolds, points);
+                        let (manifolds, points) = as_wide(&mut manifolds[..], points);
                         // SAFETY: as above.
                         return unsafe { avx(manifolds, points $(, $arg)*) };
                     }
@@ -193,57 +194,6 @@ macro_rules! wide_kernel {
             $imp::<F8>(manifolds, points $(, $arg)*)
         }
     };
-}
-
-/// Which 256-bit kernels the CPU can run.
-#[cfg(target_arch = "x86_64")]
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum AvxLevel {
-    /// AVX-512F and AVX-512VL: 256-bit lanes and 32 vector registers.
-    Avx512,
-    /// AVX: 256-bit lanes, 16 registers.
-    Avx,
-    /// Neither: the 128-bit kernels.
-    None,
-}
-
-#[cfg(target_arch = "x86_64")]
-fn avx_level() -> AvxLevel {
-    if std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512vl")
-    {
-        AvxLevel::Avx512
-    } else if std::arch::is_x86_feature_detected!("avx") {
-        AvxLevel::Avx
-    } else {
-        AvxLevel::None
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-const _: () = {
-    assert!(size_of::<PointLanes<W8>>() == size_of::<PointLanes<F8>>());
-    assert!(align_of::<PointLanes<W8>>() == align_of::<PointLanes<F8>>());
-    assert!(size_of::<ManifoldLanes<W8>>() == size_of::<ManifoldLanes<F8>>());
-    assert!(align_of::<ManifoldLanes<W8>>() == align_of::<ManifoldLanes<F8>>());
-};
-
-/// The batches viewed with `W8` lanes.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-fn as_wide<'a>(
-    manifolds: &'a [ManifoldLanes<F8>],
-    points: &'a mut [PointLanes<F8>],
-) -> (&'a [ManifoldLanes<W8>], &'a mut [PointLanes<W8>]) {
-    // SAFETY: `ManifoldLanes` and `PointLanes` are `repr(C)`, and `W8` has `F8`'s size and
-    // alignment (asserted above, and in `lanes_avx`), so both instantiations have the same
-    // layout; every bit pattern is a valid `W8`. The borrows are carried over unchanged.
-    unsafe {
-        (
-            std::slice::from_raw_parts(manifolds.as_ptr().cast(), manifolds.len()),
-            std::slice::from_raw_parts_mut(points.as_mut_ptr().cast(), points.len()),
-        )
-    }
 }
 
 /// Runs `$body` for every batch in order, with `$m` the batch, `$pair` its loaded bodies
@@ -382,8 +332,11 @@ fn project_to_disk<F: Lane>(inv_k: [F; 3], target: [F; 2], r: F, over: F::Mask) 
         & len.cmpgt(F::ZERO)
         & projected[0].is_finite_mask()
         & projected[1].is_finite_mask();
-    let pick = |i: usize| F::select(over, F::select(usable, projected[i], scaled[i]), target[i]);
-    [pick(0), pick(1)]
+    // Not a closure: it would not be compiled with the kernel's target features.
+    [
+        F::select(over, F::select(usable, projected[0], scaled[0]), target[0]),
+        F::select(over, F::select(usable, projected[1], scaled[1]), target[1]),
+    ]
 }
 
 /// What distinguishes the biased pass from the relax pass.
