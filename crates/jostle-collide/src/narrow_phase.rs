@@ -129,6 +129,13 @@ struct PointSlot {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct NarrowPhase {
     pairs: Vec<PairState>,
+    /// The previous update's pair list, kept empty between updates so its allocation is
+    /// reused instead of the list growing from nothing every step.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    spare: Vec<PairState>,
+    /// Scratch for the touching pairs of an update.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    touching_scratch: Vec<(BodyHandle, BodyHandle)>,
     contacts: Vec<BodyContact>,
     slots: Vec<PointSlot>,
     touching: Vec<(BodyHandle, BodyHandle)>,
@@ -228,10 +235,13 @@ impl NarrowPhase {
         };
         self.contacts.clear();
         self.slots.clear();
-        let mut touching = Vec::new();
+        let mut touching = std::mem::take(&mut self.touching_scratch);
+        touching.clear();
 
-        let old = std::mem::take(&mut self.pairs);
-        let mut old = old.into_iter().peekable();
+        let mut old_pairs = std::mem::replace(&mut self.pairs, std::mem::take(&mut self.spare));
+        self.pairs.clear();
+        self.pairs.reserve(pairs.len());
+        let mut old = old_pairs.drain(..).peekable();
         for &pair in pairs.iter() {
             while old.next_if(|s| s.pair < pair).is_some() {}
             let mut state = old
@@ -274,8 +284,8 @@ impl NarrowPhase {
             let pair_index = self.pairs.len() as u32;
             let mut touches = false;
             for (mi, m) in state.manifolds.iter().enumerate() {
-                let w1 = pose1 * m.subshape_pos1().copied().unwrap_or(Pose::IDENTITY);
-                let w2 = pose2 * m.subshape_pos2().copied().unwrap_or(Pose::IDENTITY);
+                let w1 = m.subshape_pos1().map_or(pose1, |sub| pose1 * sub);
+                let w2 = m.subshape_pos2().map_or(pose2, |sub| pose2 * sub);
                 // parry's normal points out of shape 1, toward shape 2.
                 let Some(n1) = (w1.rotation * m.local_n1).try_normalize() else {
                     continue;
@@ -311,6 +321,8 @@ impl NarrowPhase {
             }
             self.pairs.push(state);
         }
+        drop(old);
+        self.spare = old_pairs;
         stats.contact_points = self.contacts.len();
         self.update_events(touching, bodies);
         stats
@@ -352,7 +364,7 @@ impl NarrowPhase {
                 (None, None) => break,
             }
         }
-        self.touching = touching;
+        self.touching_scratch = std::mem::replace(&mut self.touching, touching);
     }
 }
 
@@ -382,6 +394,9 @@ fn reusable(
 
 /// The relative pose of a manifold's two sub-shapes (compound parts carry their own frames).
 fn manifold_pos12(m: &Manifold, pos12: &Pose) -> Pose {
+    if m.subshape_pos1().is_none() && m.subshape_pos2().is_none() {
+        return *pos12;
+    }
     let sub1 = m.subshape_pos1().copied().unwrap_or(Pose::IDENTITY);
     let sub2 = m.subshape_pos2().copied().unwrap_or(Pose::IDENTITY);
     sub1.inv_mul(&(pos12 * sub2))
