@@ -26,9 +26,13 @@ pub struct BodyState {
     pub delta_rotation: Quat,
     /// Displacement of the centre of mass since the start of the step (m).
     pub delta_position: Vec3,
+    /// Zero: makes the last of the 64 bytes a field, so the state reads as sixteen floats
+    /// with no padding ([`BodyState::motion_row`]).
+    pub pad: f32,
 }
 
-const _: () = assert!(size_of::<BodyState>() <= 64);
+// Sixteen four-byte fields and no padding: the rows below cover the whole struct.
+const _: () = assert!(size_of::<BodyState>() == 64 && align_of::<BodyState>() >= 4);
 
 impl BodyState {
     /// The state of the static entry: no motion, no mass.
@@ -39,6 +43,7 @@ impl BodyState {
         flags: 0,
         delta_rotation: Quat::IDENTITY,
         delta_position: Vec3::ZERO,
+        pad: 0.0,
     };
 
     /// The state of `body` at the start of the step.
@@ -50,7 +55,34 @@ impl BodyState {
             flags: body.flags,
             delta_rotation: Quat::IDENTITY,
             delta_position: Vec3::ZERO,
+            pad: 0.0,
         }
+    }
+
+    /// The first eight floats: linear velocity, 1/m, angular velocity, and the flags' bits.
+    #[inline(always)]
+    pub fn velocity_row(&self) -> &[f32; 8] {
+        // SAFETY: `BodyState` is `repr(C)`, 64 bytes of sixteen 4-byte fields with no padding
+        // (asserted above), aligned to at least 4; its first 32 bytes are the fields named
+        // above, and every bit pattern is a valid `f32` (the flags are read as their bits).
+        unsafe { &*(self as *const BodyState).cast::<[f32; 8]>() }
+    }
+
+    /// [`BodyState::velocity_row`], writable. Whatever is written to lane 7 becomes the
+    /// flags' bits, so callers write back what they read there.
+    #[inline(always)]
+    pub fn velocity_row_mut(&mut self) -> &mut [f32; 8] {
+        // SAFETY: as for `velocity_row`; every bit pattern is also a valid `u32`.
+        unsafe { &mut *(self as *mut BodyState).cast::<[f32; 8]>() }
+    }
+
+    /// The last eight floats: the rotation since the start of the step (x, y, z, w), the
+    /// displacement, and the zero pad.
+    #[inline(always)]
+    pub fn motion_row(&self) -> &[f32; 8] {
+        // SAFETY: as for `velocity_row`; bytes 32..64 are `delta_rotation`, `delta_position`
+        // and `pad`.
+        unsafe { &*(self as *const BodyState).cast::<[f32; 8]>().add(1) }
     }
 
     /// Whether angular terms apply to this body.
@@ -67,5 +99,32 @@ impl BodyState {
         if self.rotates() {
             body.orientation = (self.delta_rotation * body.orientation).normalize();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_rows_are_the_fields_in_order() {
+        let s = BodyState {
+            linear_velocity: Vec3::new(1.0, 2.0, 3.0),
+            inv_mass: 4.0,
+            angular_velocity: Vec3::new(5.0, 6.0, 7.0),
+            flags: 8.0f32.to_bits(),
+            delta_rotation: Quat::from_xyzw(9.0, 10.0, 11.0, 12.0),
+            delta_position: Vec3::new(13.0, 14.0, 15.0),
+            pad: 0.0,
+        };
+        assert_eq!(s.velocity_row(), &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]);
+        assert_eq!(
+            s.motion_row(),
+            &[9.0, 10.0, 11.0, 12.0, 13.0, 14.0, 15.0, 0.0]
+        );
+        let mut t = s;
+        t.velocity_row_mut()[4] = -5.0;
+        assert_eq!(t.angular_velocity, Vec3::new(-5.0, 6.0, 7.0));
+        assert_eq!(t.flags, s.flags);
     }
 }

@@ -233,6 +233,27 @@ pub trait Lane:
     fn cmple(self, o: Self) -> Self::Mask;
     /// Lane-wise `==`.
     fn cmpeq(self, o: Self) -> Self::Mask;
+
+    /// Eight rows of eight floats, transposed: lane `i` of `result[j]` is `rows[i][j]`.
+    #[inline(always)]
+    fn load_transposed(rows: [&[f32; WIDTH]; WIDTH]) -> [Self; WIDTH] {
+        std::array::from_fn(|j| Self::from_array(std::array::from_fn(|i| rows[i][j])))
+    }
+
+    /// The transpose of eight vectors: lane `j` of `result[i]` is lane `i` of `cols[j]`.
+    #[inline(always)]
+    fn transpose(cols: [Self; WIDTH]) -> [Self; WIDTH] {
+        std::array::from_fn(|i| Self::from_array(std::array::from_fn(|j| cols[j][i])))
+    }
+
+    /// Writes lanes 0–2 and 4–6 to `dst`, leaving `dst[3]` and `dst[7]` as they are (a
+    /// [`super::BodyState`] velocity row keeps its 1/m and flags).
+    #[inline(always)]
+    fn store_skipping_3_and_7(self, dst: &mut [f32; WIDTH]) {
+        for i in [0, 1, 2, 4, 5, 6] {
+            dst[i] = self[i];
+        }
+    }
 }
 
 /// A lane-wise boolean mask of a [`Lane`] type.

@@ -144,6 +144,66 @@ impl Lane for W8 {
 
     // SSE's `cmpgt`/`cmplt`/`cmple` are the signalling ordered predicates, `cmpeq` the quiet
     // ordered one; the masks they give are the same for every input.
+    #[inline(always)]
+    fn load_transposed(rows: [&[f32; WIDTH]; WIDTH]) -> [Self; WIDTH] {
+        // SAFETY: see the file header; unaligned loads of eight f32 each.
+        let load = |row: &[f32; WIDTH]| unsafe { W8(_mm256_loadu_ps(row.as_ptr())) };
+        Self::transpose([
+            load(rows[0]),
+            load(rows[1]),
+            load(rows[2]),
+            load(rows[3]),
+            load(rows[4]),
+            load(rows[5]),
+            load(rows[6]),
+            load(rows[7]),
+        ])
+    }
+
+    #[inline(always)]
+    fn transpose(c: [Self; WIDTH]) -> [Self; WIDTH] {
+        // SAFETY: see the file header. The classic 8×8 transpose: interleave pairs of rows,
+        // then pairs of pairs within each 128-bit half, then swap the halves.
+        unsafe {
+            let t0 = _mm256_unpacklo_ps(c[0].0, c[1].0);
+            let t1 = _mm256_unpackhi_ps(c[0].0, c[1].0);
+            let t2 = _mm256_unpacklo_ps(c[2].0, c[3].0);
+            let t3 = _mm256_unpackhi_ps(c[2].0, c[3].0);
+            let t4 = _mm256_unpacklo_ps(c[4].0, c[5].0);
+            let t5 = _mm256_unpackhi_ps(c[4].0, c[5].0);
+            let t6 = _mm256_unpacklo_ps(c[6].0, c[7].0);
+            let t7 = _mm256_unpackhi_ps(c[6].0, c[7].0);
+            let u0 = _mm256_shuffle_ps::<0x44>(t0, t2);
+            let u1 = _mm256_shuffle_ps::<0xEE>(t0, t2);
+            let u2 = _mm256_shuffle_ps::<0x44>(t1, t3);
+            let u3 = _mm256_shuffle_ps::<0xEE>(t1, t3);
+            let u4 = _mm256_shuffle_ps::<0x44>(t4, t6);
+            let u5 = _mm256_shuffle_ps::<0xEE>(t4, t6);
+            let u6 = _mm256_shuffle_ps::<0x44>(t5, t7);
+            let u7 = _mm256_shuffle_ps::<0xEE>(t5, t7);
+            [
+                W8(_mm256_permute2f128_ps::<0x20>(u0, u4)),
+                W8(_mm256_permute2f128_ps::<0x20>(u1, u5)),
+                W8(_mm256_permute2f128_ps::<0x20>(u2, u6)),
+                W8(_mm256_permute2f128_ps::<0x20>(u3, u7)),
+                W8(_mm256_permute2f128_ps::<0x31>(u0, u4)),
+                W8(_mm256_permute2f128_ps::<0x31>(u1, u5)),
+                W8(_mm256_permute2f128_ps::<0x31>(u2, u6)),
+                W8(_mm256_permute2f128_ps::<0x31>(u3, u7)),
+            ]
+        }
+    }
+
+    #[inline(always)]
+    fn store_skipping_3_and_7(self, dst: &mut [f32; WIDTH]) {
+        // SAFETY: see the file header; an unaligned load and store of eight f32.
+        unsafe {
+            let old = _mm256_loadu_ps(dst.as_ptr());
+            let new = _mm256_blend_ps::<0b1000_1000>(self.0, old);
+            _mm256_storeu_ps(dst.as_mut_ptr(), new);
+        }
+    }
+
     compare!(cmpgt, _CMP_GT_OS);
     compare!(cmplt, _CMP_LT_OS);
     compare!(cmple, _CMP_LE_OS);

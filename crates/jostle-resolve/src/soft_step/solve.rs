@@ -39,41 +39,97 @@ struct Motion<F> {
     rotation: Q8<F>,
 }
 
+/// The states of the eight lanes' bodies.
+#[inline(always)]
+fn lane_states(states: &[BodyState], idx: [u32; LANES]) -> [&BodyState; LANES] {
+    // Written out: an array `map` is a closure, which would not be inlined into the kernel.
+    [
+        &states[idx[0] as usize],
+        &states[idx[1] as usize],
+        &states[idx[2] as usize],
+        &states[idx[3] as usize],
+        &states[idx[4] as usize],
+        &states[idx[5] as usize],
+        &states[idx[6] as usize],
+        &states[idx[7] as usize],
+    ]
+}
+
 #[inline(always)]
 fn gather_velocities<F: Lane>(states: &[BodyState], idx: [u32; LANES]) -> Velocities<F> {
-    let mut v = Velocities {
-        linear: V3x8::ZERO,
-        angular: V3x8::ZERO,
-    };
-    for (lane, &i) in idx.iter().enumerate() {
-        let s = &states[i as usize];
-        v.linear.set_lane(lane, s.linear_velocity);
-        v.angular.set_lane(lane, s.angular_velocity);
+    let s = lane_states(states, idx);
+    let rows = [
+        s[0].velocity_row(),
+        s[1].velocity_row(),
+        s[2].velocity_row(),
+        s[3].velocity_row(),
+        s[4].velocity_row(),
+        s[5].velocity_row(),
+        s[6].velocity_row(),
+        s[7].velocity_row(),
+    ];
+    let [lx, ly, lz, _, ax, ay, az, _] = F::load_transposed(rows);
+    Velocities {
+        linear: V3x8 {
+            x: lx,
+            y: ly,
+            z: lz,
+        },
+        angular: V3x8 {
+            x: ax,
+            y: ay,
+            z: az,
+        },
     }
-    v
 }
 
 #[inline(always)]
 fn gather_motion<F: Lane>(states: &[BodyState], idx: [u32; LANES]) -> Motion<F> {
-    let mut m = Motion {
-        position: V3x8::ZERO,
-        rotation: Q8::IDENTITY,
-    };
-    for (lane, &i) in idx.iter().enumerate() {
-        let s = &states[i as usize];
-        m.position.set_lane(lane, s.delta_position);
-        m.rotation.set_lane(lane, s.delta_rotation);
+    let s = lane_states(states, idx);
+    let rows = [
+        s[0].motion_row(),
+        s[1].motion_row(),
+        s[2].motion_row(),
+        s[3].motion_row(),
+        s[4].motion_row(),
+        s[5].motion_row(),
+        s[6].motion_row(),
+        s[7].motion_row(),
+    ];
+    let [qx, qy, qz, qw, px, py, pz, _] = F::load_transposed(rows);
+    Motion {
+        position: V3x8 {
+            x: px,
+            y: py,
+            z: pz,
+        },
+        rotation: Q8 {
+            v: V3x8 {
+                x: qx,
+                y: qy,
+                z: qz,
+            },
+            w: qw,
+        },
     }
-    m
 }
 
 #[inline(always)]
 fn scatter_velocities<F: Lane>(states: &mut [BodyState], idx: [u32; LANES], v: &Velocities<F>) {
+    // Lanes 3 and 7 of each row are the body's 1/m and flags, which the store leaves alone.
+    let rows = F::transpose([
+        v.linear.x,
+        v.linear.y,
+        v.linear.z,
+        F::ZERO,
+        v.angular.x,
+        v.angular.y,
+        v.angular.z,
+        F::ZERO,
+    ]);
     for (lane, &i) in idx.iter().enumerate() {
         if i != STATIC_BODY {
-            let s = &mut states[i as usize];
-            s.linear_velocity = v.linear.lane(lane);
-            s.angular_velocity = v.angular.lane(lane);
+            rows[lane].store_skipping_3_and_7(states[i as usize].velocity_row_mut());
         }
     }
 }
