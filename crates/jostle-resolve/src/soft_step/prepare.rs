@@ -2,7 +2,7 @@
 //!
 //! Everything the substep loop needs is computed here once per step, so the kernels touch
 //! only a [`PointLanes`] and the bodies' velocities and motion: the anchors, the normal and
-//! tangents (of [`contact_basis`], the convention of the stored impulses), the angular
+//! tangents (of [`jostle_math::contact_basis`], computed lane-wise; the convention of the stored impulses), the angular
 //! response of each body to a unit impulse along each direction (I⁻¹·(r × d), so no inertia
 //! matrix is loaded in the loop), the normal effective mass 1/(n·K·n), the inverse 2×2
 //! tangent effective mass (so one friction solve is exact for both tangents together), the
@@ -17,7 +17,7 @@ use super::batch::{LANES, ManifoldLanes, NO_SOURCE, PointLanes};
 use super::lanes::{F8, Lane, V3x8, WIDTH};
 use super::softness::Softness;
 use crate::{Contact, SolverBody};
-use jostle_math::{Mat3, Vec3, contact_basis};
+use jostle_math::{Mat3, Vec3};
 
 /// What [`prepare_point`] needs besides the contact and its bodies.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -94,18 +94,17 @@ pub fn prepare_point<F: Lane>(
 ) {
     // Lane by lane into arrays, then one load per component (writing lanes of a vector one
     // at a time would stall the load that follows on every store).
-    let mut vectors = [[Vec3::ZERO; WIDTH]; 5];
+    let mut vectors = [[Vec3::ZERO; WIDTH]; 3];
+    let mut present = [0.0; WIDTH];
     let mut penetration = [0.0; WIDTH];
     let mut friction = [0.0; WIDTH];
     let mut restitution = [0.0; WIDTH];
     for (lane, c) in contacts.iter().enumerate() {
         if let Some(c) = c {
-            let basis = contact_basis(c.normal);
-            vectors[0][lane] = basis.x_axis;
-            vectors[1][lane] = basis.y_axis;
-            vectors[2][lane] = basis.z_axis;
-            vectors[3][lane] = c.point;
-            vectors[4][lane] = c.impulse;
+            vectors[0][lane] = c.normal;
+            vectors[1][lane] = c.point;
+            vectors[2][lane] = c.impulse;
+            present[lane] = 1.0;
             penetration[lane] = c.penetration;
             friction[lane] = c.friction;
             restitution[lane] = c.restitution;
@@ -113,13 +112,25 @@ pub fn prepare_point<F: Lane>(
     }
     // No closures over lanes here or below: a closure is not compiled with the target
     // features of the kernel it sits in, so every lane operation in it would be a call.
-    let [n, t1, t2, point, stored] = [
+    let [n, point, stored] = [
         V3x8::<F>::from_lanes(vectors[0]),
         V3x8::from_lanes(vectors[1]),
         V3x8::from_lanes(vectors[2]),
-        V3x8::from_lanes(vectors[3]),
-        V3x8::from_lanes(vectors[4]),
     ];
+    // `contact_basis` lane by lane, the same operations in the same order: t₁ = n × a
+    // normalised, with a = x̂ unless |n.x| ≥ 0.6 (then ŷ), and t₂ = n × t₁. Padding lanes
+    // (zero normal) get zero tangents instead of the NaN the normalisation gives them.
+    let use_x = n.x.abs().cmplt(F::splat(0.6));
+    let axis = V3x8 {
+        x: F::select(use_x, F::ONE, F::ZERO),
+        y: F::select(use_x, F::ZERO, F::ONE),
+        z: F::ZERO,
+    };
+    let present = F::from_array(present).cmpgt(F::ZERO);
+    let t1 = n.cross(axis);
+    let t1 = t1 * t1.dot(t1).sqrt().recip();
+    let t2 = n.cross(t1);
+    let (t1, t2) = (zero_unless(present, t1), zero_unless(present, t2));
     let r_a = point - a.position;
     let r_b = point - b.position;
     let m = a.inv_mass + b.inv_mass;
@@ -178,6 +189,16 @@ pub fn prepare_point<F: Lane>(
         restitution: F::from_array(restitution),
         relative_velocity: dv.dot(n),
     };
+}
+
+/// `v` in the lanes of `mask`, zero in the others.
+#[inline(always)]
+fn zero_unless<F: Lane>(mask: F::Mask, v: V3x8<F>) -> V3x8<F> {
+    V3x8 {
+        x: F::select(mask, v.x, F::ZERO),
+        y: F::select(mask, v.y, F::ZERO),
+        z: F::select(mask, v.z, F::ZERO),
+    }
 }
 
 /// Prepares every point of the packed batches: for each batch, its bodies are gathered once
@@ -289,5 +310,55 @@ mod tests {
         );
         assert_eq!(format!("{:?}", batches.points), format!("{points:?}"));
         assert_eq!(format!("{:?}", batches.manifolds), format!("{manifolds:?}"));
+    }
+
+    /// The lane-wise basis is `contact_basis`, bit for bit, for normals on both sides of the
+    /// |n.x| = 0.6 switch; padding lanes get zero tangents.
+    #[test]
+    fn tangents_are_those_of_contact_basis() {
+        let mut rng = synthetic::Rng::new(5);
+        let bodies = [
+            SolverBody::STATIC,
+            synthetic::box_body(
+                Vec3::new(0.0, 1.0, 0.0),
+                jostle_math::Quat::IDENTITY,
+                1.0,
+                Vec3::splat(0.5),
+            ),
+        ];
+        let lanes = BodyLanes::<F8>::gather(&bodies, [1, 1, 1, 1, 1, 1, 1, 0]);
+        let statics = BodyLanes::<F8>::gather(&bodies, [0; WIDTH]);
+        let params = PrepareParams {
+            static_softness: Softness::new(60.0, 10.0, 0.01),
+            dynamic_softness: Softness::new(30.0, 10.0, 0.01),
+            warm_scale: 0.25,
+        };
+        for _ in 0..50 {
+            let contacts: Vec<Contact> = (0..WIDTH - 1)
+                .map(|_| {
+                    let n = rng.vec(1.0).try_normalize().unwrap_or(Vec3::Y);
+                    Contact::new(1, 0, rng.vec(1.0), n, 0.01)
+                })
+                .collect();
+            let mut lane_contacts = [None; WIDTH];
+            for (slot, c) in lane_contacts.iter_mut().zip(&contacts) {
+                *slot = Some(c);
+            }
+            let mut out = PointLanes::default();
+            prepare_point(&mut out, lane_contacts, &lanes, &statics, &params);
+            for (lane, c) in contacts.iter().enumerate() {
+                let basis = jostle_math::contact_basis(c.normal);
+                assert_eq!(
+                    out.tangent1.lane(lane).to_array().map(f32::to_bits),
+                    basis.y_axis.to_array().map(f32::to_bits)
+                );
+                assert_eq!(
+                    out.tangent2.lane(lane).to_array().map(f32::to_bits),
+                    basis.z_axis.to_array().map(f32::to_bits)
+                );
+            }
+            assert_eq!(out.tangent1.lane(WIDTH - 1), Vec3::ZERO);
+            assert_eq!(out.tangent2.lane(WIDTH - 1), Vec3::ZERO);
+        }
     }
 }
