@@ -249,11 +249,10 @@ pub(crate) fn scatter(
     for (_, body) in bodies.iter_mut() {
         body.clear_forces();
     }
-    let mut impulses: Vec<_> = narrow.contacts().iter().map(|c| c.impulse).collect();
+    // Contacts the resolver did not see (between two fixed or sleeping bodies) keep theirs.
     for (contact, &source) in scratch.contacts.iter().zip(&scratch.contact_source) {
-        impulses[source as usize] = contact.impulse;
+        narrow.store_impulse(source as usize, contact.impulse);
     }
-    narrow.store_impulses(&impulses);
 }
 
 /// Updates motion averages, finds islands and puts resting islands to sleep; fills the

@@ -59,7 +59,12 @@ impl Collider {
 
     /// The collider's world pose on `body`: body pose (centre of mass, orientation) × local pose.
     pub fn world_pose(&self, body: &RigidBody) -> Pose {
-        body_pose(body) * self.local_pose
+        // Most colliders sit at their body's centre of mass: skip the composition.
+        if self.local_pose == Pose::IDENTITY {
+            body_pose(body)
+        } else {
+            body_pose(body) * self.local_pose
+        }
     }
 
     /// Whether the shape is unbounded (a half-space): it has no finite bounding box.

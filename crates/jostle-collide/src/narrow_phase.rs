@@ -199,16 +199,28 @@ impl NarrowPhase {
     /// contact of [`NarrowPhase::contacts`], in the same order. Extra impulses are ignored;
     /// contacts without one keep theirs.
     pub fn store_impulses(&mut self, impulses: &[Vec3]) {
-        for ((slot, contact), &impulse) in self.slots.iter().zip(&mut self.contacts).zip(impulses) {
-            contact.impulse = impulse;
-            let point = self
-                .pairs
-                .get_mut(slot.pair as usize)
-                .and_then(|p| p.manifolds.get_mut(slot.manifold as usize))
-                .and_then(|m| m.points.get_mut(slot.point as usize));
-            if let Some(point) = point {
-                point.data.impulse = impulse;
-            }
+        for (i, &impulse) in impulses.iter().enumerate() {
+            self.store_impulse(i, impulse);
+        }
+    }
+
+    /// Writes the resolver's accumulated impulse for contact `index` of
+    /// [`NarrowPhase::contacts`] back into its persistent point; an index past the contacts is
+    /// ignored.
+    #[inline]
+    pub fn store_impulse(&mut self, index: usize, impulse: Vec3) {
+        let (Some(slot), Some(contact)) = (self.slots.get(index), self.contacts.get_mut(index))
+        else {
+            return;
+        };
+        contact.impulse = impulse;
+        let point = self
+            .pairs
+            .get_mut(slot.pair as usize)
+            .and_then(|p| p.manifolds.get_mut(slot.manifold as usize))
+            .and_then(|m| m.points.get_mut(slot.point as usize));
+        if let Some(point) = point {
+            point.data.impulse = impulse;
         }
     }
 
