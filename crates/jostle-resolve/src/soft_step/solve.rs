@@ -206,7 +206,9 @@ fn separation<F: Lane>(p: &PointLanes<F>, a: &Motion<F>, b: &Motion<F>) -> F {
 /// Elsewhere it runs with [`F8`] lanes (two 128-bit halves). The lane operations are the same
 /// IEEE operations in all three (no fused multiply-add is introduced), so results are
 /// bit-identical on every CPU. Measured on the 20-row pyramid (`jostle run
-/// assets/pyramid_20.ron`, AMD EPYC with AVX-512): see RESULTS.md, "Each pipeline stage".
+/// assets/pyramid_20.ron --no-sleep`, AMD EPYC with AVX-512, resolve stage median): 0.245 ms
+/// per step with 128-bit halves, 0.200 ms with 256-bit lanes (RESULTS.md, "What changed on
+/// 2026-11-22, afternoon").
 macro_rules! wide_kernel {
     ($(#[$doc:meta])* pub fn $name:ident(batches: &mut Batches $(, $arg:ident: $ty:ty)*) -> $ret:ty = $imp:ident;) => {
         $(#[$doc])*
