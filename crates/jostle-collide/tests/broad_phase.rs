@@ -124,7 +124,9 @@ fn agrees_with_brute_force_on_random_scenes() {
     let margin = 0.05;
     let mut bp = BroadPhase::new();
     let mut total = 0;
-    for step in 0..6 {
+    // Twelve updates: the broad phase keeps its candidate pairs between updates and repairs
+    // them around the leaves that changed, so later steps check that repair.
+    for step in 0..12 {
         let pairs = bp.update(&colliders, &bodies, margin).to_vec();
         let expected = brute_force(&colliders, &bodies, margin);
         assert_eq!(pairs.len(), expected.len(), "step {step}");
@@ -151,7 +153,20 @@ fn agrees_with_brute_force_on_random_scenes() {
         for v in victims {
             colliders.remove(v);
         }
-        let h = handles[step * 7];
+        // Steps 4–7 run mostly asleep (the broad phase then queries from the awake bodies and
+        // lets its cached pairs go stale); step 8 wakes everything, so the cache is repaired
+        // after the changes that piled up.
+        if step == 3 {
+            for (k, &h) in handles.iter().enumerate() {
+                bodies.get_mut(h).unwrap().sleep.awake = k % 10 == 0;
+            }
+        }
+        if step == 7 {
+            for &h in &handles {
+                bodies.get_mut(h).unwrap().sleep.awake = true;
+            }
+        }
+        let h = handles[step * 7 % handles.len()];
         colliders.insert(Collider::new(SharedShapeBall::make(0.3), h));
     }
     assert!(
@@ -259,4 +274,64 @@ fn a_sleeping_body_costs_no_pair_with_the_ground() {
             .update(&scene.colliders, &scene.bodies, 0.02)
             .is_empty()
     );
+}
+
+/// A packed grid of resting (awake, unmoving) boxes that three boxes sweep through, one small
+/// step at a time: the broad phase repairs its cached pairs only around the leaves that
+/// changed, and must still agree with brute force at every step; then most of the grid falls
+/// asleep for a while (the broad phase queries from the awake boxes and its cache goes stale)
+/// and wakes again.
+#[test]
+fn cached_pairs_follow_a_few_moving_bodies() {
+    let mut bodies = BodySet::new();
+    let mut colliders = ColliderSet::new();
+    let cube = ShapeDesc::Cuboid {
+        half_extents: Vec3::splat(0.5),
+    };
+    let mut grid = Vec::new();
+    for x in 0..12 {
+        for z in 0..12 {
+            let body = RigidBody::dynamic(1.0, Mat3::IDENTITY).unwrap().with_pose(
+                Vec3::new(x as f32 * 1.01, 0.0, z as f32 * 1.01),
+                Quat::IDENTITY,
+            );
+            let h = bodies.insert(body);
+            colliders.insert(Collider::new(cube.build().unwrap(), h));
+            grid.push(h);
+        }
+    }
+    let movers: Vec<BodyHandle> = (0..3)
+        .map(|k| {
+            let body = RigidBody::dynamic(1.0, Mat3::IDENTITY).unwrap().with_pose(
+                Vec3::new(-1.0, 0.3 * k as f32, 2.0 + 3.5 * k as f32),
+                Quat::IDENTITY,
+            );
+            let h = bodies.insert(body);
+            colliders.insert(Collider::new(cube.build().unwrap(), h));
+            h
+        })
+        .collect();
+    let margin = 0.02;
+    let mut bp = BroadPhase::new();
+    let mut moving_pairs = 0;
+    for step in 0..160 {
+        let pairs = bp.update(&colliders, &bodies, margin).to_vec();
+        assert_eq!(
+            pairs,
+            brute_force(&colliders, &bodies, margin),
+            "step {step}"
+        );
+        moving_pairs += pairs.len();
+        for (k, &h) in movers.iter().enumerate() {
+            let b = bodies.get_mut(h).unwrap();
+            b.position += Vec3::new(0.09, 0.0, 0.01 * k as f32);
+        }
+        if step == 60 || step == 100 {
+            let awake = step == 100;
+            for (k, &h) in grid.iter().enumerate() {
+                bodies.get_mut(h).unwrap().sleep.awake = awake || k % 17 == 0;
+            }
+        }
+    }
+    assert!(moving_pairs > 160 * 200, "{moving_pairs}");
 }
