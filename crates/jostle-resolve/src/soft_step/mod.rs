@@ -33,6 +33,56 @@
 // `!(x > 0.0)` is deliberate: it is true for NaN, which must take the "do nothing" branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+/// Calls the `#[inline(always)]` generic `$imp::<F>(manifolds, points, args…)` with the lane
+/// type the CPU runs best, and returns its result: on x86-64 CPUs with AVX, [`lanes_avx`]'s
+/// 256-bit `W8` on the same storage read in place, inside a function compiled for AVX-512VL
+/// (its 32 vector registers hold a batch's velocities and a point's data without spills) or for
+/// AVX; elsewhere [`lanes::F8`] (two 128-bit halves). The lane operations are the same IEEE
+/// operations in every case (no fused multiply-add is introduced), so results are
+/// bit-identical on every CPU. Used by the kernels of [`solve`] and by
+/// [`prepare::prepare_batches`].
+macro_rules! with_best_lanes {
+    ($imp:ident($manifolds:expr, $points:expr $(, $arg:ident: $ty:ty)*) -> $ret:ty) => {{
+        let manifolds: &mut [$crate::soft_step::batch::ManifoldLanes] = $manifolds;
+        let points: &mut [$crate::soft_step::batch::PointLanes] = $points;
+        #[cfg(target_arch = "x86_64")]
+        {
+            use $crate::soft_step::batch::{ManifoldLanes, PointLanes};
+            use $crate::soft_step::lanes_avx::{AvxLevel, W8, as_wide, avx_level};
+            #[target_feature(enable = "avx512f,avx512vl")]
+            fn avx512(
+                manifolds: &mut [ManifoldLanes<W8>],
+                points: &mut [PointLanes<W8>]
+                $(, $arg: $ty)*
+            ) -> $ret {
+                $imp(manifolds, points $(, $arg)*)
+            }
+            #[target_feature(enable = "avx")]
+            fn avx(
+                manifolds: &mut [ManifoldLanes<W8>],
+                points: &mut [PointLanes<W8>]
+                $(, $arg: $ty)*
+            ) -> $ret {
+                $imp(manifolds, points $(, $arg)*)
+            }
+            match avx_level() {
+                AvxLevel::Avx512 => {
+                    let (manifolds, points) = as_wide(manifolds, points);
+                    // SAFETY: the CPU has been detected to support the enabled features.
+                    return unsafe { avx512(manifolds, points $(, $arg)*) };
+                }
+                AvxLevel::Avx => {
+                    let (manifolds, points) = as_wide(manifolds, points);
+                    // SAFETY: as above.
+                    return unsafe { avx(manifolds, points $(, $arg)*) };
+                }
+                AvxLevel::None => {}
+            }
+        }
+        $imp::<$crate::soft_step::lanes::F8>(manifolds, points $(, $arg)*)
+    }};
+}
+
 pub mod batch;
 pub mod body_state;
 pub mod gyroscopic;

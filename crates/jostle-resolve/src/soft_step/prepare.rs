@@ -213,46 +213,14 @@ pub fn prepare_batches(
     bodies: &[SolverBody],
     params: &PrepareParams,
 ) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use super::lanes_avx::{AvxLevel, W8, as_wide, avx_level};
-        #[target_feature(enable = "avx512f,avx512vl")]
-        fn avx512(
-            manifolds: &mut [ManifoldLanes<W8>],
-            points: &mut [PointLanes<W8>],
-            sources: &[[u32; LANES]],
-            contacts: &[Contact],
-            bodies: &[SolverBody],
-            params: &PrepareParams,
-        ) {
-            prepare_batches_impl(manifolds, points, sources, contacts, bodies, params)
-        }
-        #[target_feature(enable = "avx")]
-        fn avx(
-            manifolds: &mut [ManifoldLanes<W8>],
-            points: &mut [PointLanes<W8>],
-            sources: &[[u32; LANES]],
-            contacts: &[Contact],
-            bodies: &[SolverBody],
-            params: &PrepareParams,
-        ) {
-            prepare_batches_impl(manifolds, points, sources, contacts, bodies, params)
-        }
-        match avx_level() {
-            AvxLevel::Avx512 => {
-                let (manifolds, points) = as_wide(manifolds, points);
-                // SAFETY: the CPU has been detected to support the enabled features.
-                return unsafe { avx512(manifolds, points, sources, contacts, bodies, params) };
-            }
-            AvxLevel::Avx => {
-                let (manifolds, points) = as_wide(manifolds, points);
-                // SAFETY: as above.
-                return unsafe { avx(manifolds, points, sources, contacts, bodies, params) };
-            }
-            AvxLevel::None => {}
-        }
-    }
-    prepare_batches_impl::<F8>(manifolds, points, sources, contacts, bodies, params)
+    with_best_lanes!(prepare_batches_impl(
+        manifolds,
+        points,
+        sources: &[[u32; LANES]],
+        contacts: &[Contact],
+        bodies: &[SolverBody],
+        params: &PrepareParams
+    ) -> ())
 }
 
 #[inline(always)]

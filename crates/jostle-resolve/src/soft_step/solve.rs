@@ -21,8 +21,6 @@
 use super::batch::{Batches, LANES, ManifoldLanes, PointLanes};
 use super::body_state::BodyState;
 use super::lanes::{F8, Lane, LaneMask, Q8, V3x8};
-#[cfg(target_arch = "x86_64")]
-use super::lanes_avx::W8;
 use crate::STATIC_BODY;
 
 /// The velocities of eight bodies, by lane.
@@ -198,17 +196,10 @@ fn separation<F: Lane>(p: &PointLanes<F>, a: &Motion<F>, b: &Motion<F>) -> F {
 }
 
 /// Defines `pub fn $name(batches, …)` running the `#[inline(always)]` generic body
-/// `$imp::<F>(manifolds, points, …)`. On x86-64 CPUs with AVX the body runs compiled for AVX
-/// with `W8` lanes (one 256-bit register per eight lanes, read in place from the
-/// [`F8`]-prepared batches, whose layout is the same), and with AVX-512VL compiled for it too:
-/// the kernels keep eight bodies' velocities and a point's data live at once, more than the
-/// 16 vector registers of SSE or AVX hold, and AVX-512VL's 32 registers remove the spills.
-/// Elsewhere it runs with [`F8`] lanes (two 128-bit halves). The lane operations are the same
-/// IEEE operations in all three (no fused multiply-add is introduced), so results are
-/// bit-identical on every CPU. Measured on the 20-row pyramid (`jostle run
-/// assets/pyramid_20.ron --no-sleep`, AMD EPYC with AVX-512, resolve stage median): 0.245 ms
-/// per step with 128-bit halves, 0.200 ms with 256-bit lanes (RESULTS.md, "What changed on
-/// 2026-11-22, afternoon").
+/// `$imp::<F>(manifolds, points, …)` with the best lanes the CPU has (`with_best_lanes!`).
+/// Measured on the 20-row pyramid (`jostle run assets/pyramid_20.ron --no-sleep`, AMD EPYC with
+/// AVX-512, resolve stage median): 0.245 ms per step with 128-bit halves, 0.200 ms with 256-bit
+/// lanes (RESULTS.md, "What changed on 2026-11-22, afternoon").
 macro_rules! wide_kernel {
     ($(#[$doc:meta])* pub fn $name:ident(batches: &mut Batches $(, $arg:ident: $ty:ty)*) -> $ret:ty = $imp:ident;) => {
         $(#[$doc])*
@@ -216,40 +207,7 @@ macro_rules! wide_kernel {
             let Batches {
                 manifolds, points, ..
             } = batches;
-            #[cfg(target_arch = "x86_64")]
-            {
-                #[target_feature(enable = "avx512f,avx512vl")]
-                fn avx512(
-                    manifolds: &[ManifoldLanes<W8>],
-                    points: &mut [PointLanes<W8>]
-                    $(, $arg: $ty)*
-                ) -> $ret {
-                    $imp(manifolds, points $(, $arg)*)
-                }
-                #[target_feature(enable = "avx")]
-                fn avx(
-                    manifolds: &[ManifoldLanes<W8>],
-                    points: &mut [PointLanes<W8>]
-                    $(, $arg: $ty)*
-                ) -> $ret {
-                    $imp(manifolds, points $(, $arg)*)
-                }
-                use super::lanes_avx::{AvxLevel, as_wide, avx_level};
-                match avx_level() {
-                    AvxLevel::Avx512 => {
-                        let (manifolds, points) = as_wide(&mut manifolds[..], points);
-                        // SAFETY: the CPU has been detected to support the enabled features.
-                        return unsafe { avx512(manifolds, points $(, $arg)*) };
-                    }
-                    AvxLevel::Avx => {
-                        let (manifolds, points) = as_wide(&mut manifolds[..], points);
-                        // SAFETY: as above.
-                        return unsafe { avx(manifolds, points $(, $arg)*) };
-                    }
-                    AvxLevel::None => {}
-                }
-            }
-            $imp::<F8>(manifolds, points $(, $arg)*)
+            with_best_lanes!($imp(manifolds, points $(, $arg: $ty)*) -> $ret)
         }
     };
 }
