@@ -39,7 +39,8 @@ pub struct StepProfile {
     pub awake_bodies: usize,
     /// Sleeping dynamic bodies at the end of the step.
     pub sleeping_bodies: usize,
-    /// Islands of touching awake bodies this step.
+    /// Islands of touching awake bodies this step; 0 when sleeping is disabled (islands are
+    /// only looked for to put them to sleep).
     pub islands_count: usize,
     /// Bodies swept by continuous collision detection this step (fast ones, or forced on).
     pub ccd_bodies: usize,

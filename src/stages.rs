@@ -255,8 +255,8 @@ pub(crate) fn scatter(
     }
 }
 
-/// Updates motion averages, finds islands and puts resting islands to sleep; fills the
-/// profile's body and island counters.
+/// When sleeping is enabled: updates motion averages, finds islands and puts resting islands to
+/// sleep. Always: fills the profile's body counters (and the island count when enabled).
 pub(crate) fn sleep(
     bodies: &mut BodySet,
     islands: &mut IslandSet,
@@ -265,16 +265,18 @@ pub(crate) fn sleep(
     dt: f32,
     p: &mut StepProfile,
 ) {
-    let mut qualifies = vec![false; bodies.capacity_index()];
+    // With sleeping disabled no island can go to sleep, so none is looked for (bodies that
+    // fell asleep before it was disabled keep their islands, which still wake together).
     if settings.enabled {
+        let mut qualifies = vec![false; bodies.capacity_index()];
         for (h, body) in bodies.iter_mut() {
             if body.is_awake() {
                 qualifies[h.index() as usize] = update_motion(body, settings, dt);
             }
         }
+        islands.update(bodies, contacts.iter().map(|c| (c.a, c.b)), &qualifies);
+        p.islands_count = islands.awake_islands();
     }
-    islands.update(bodies, contacts.iter().map(|c| (c.a, c.b)), &qualifies);
-    p.islands_count = islands.awake_islands();
     for (_, body) in bodies.iter() {
         if !body.is_fixed() {
             if body.sleep.awake {
