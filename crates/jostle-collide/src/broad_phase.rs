@@ -383,6 +383,14 @@ impl BroadPhase {
             let touched = |i: u32| mask.get(i as usize).copied().unwrap_or(true);
             self.fat_pairs.retain(|&(i, j)| !touched(i) && !touched(j));
             for &c in &self.changed {
+                // A slot may be listed several times: query its leaf once (clearing its bit).
+                let first = self
+                    .changed_mask
+                    .get_mut(c as usize)
+                    .is_some_and(|m| std::mem::replace(m, false));
+                if !first {
+                    continue;
+                }
                 if let Some(fat) = leaf(&self.proxies, c) {
                     for j in self.tree.intersect_aabb(&fat) {
                         if j != c {

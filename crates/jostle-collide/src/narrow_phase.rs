@@ -199,18 +199,24 @@ impl NarrowPhase {
     /// contact of [`NarrowPhase::contacts`], in the same order. Extra impulses are ignored;
     /// contacts without one keep theirs.
     pub fn store_impulses(&mut self, impulses: &[Vec3]) {
-        for (i, &impulse) in impulses.iter().enumerate() {
+        let n = impulses.len().min(self.contacts.len());
+        for (i, &impulse) in impulses[..n].iter().enumerate() {
             self.store_impulse(i, impulse);
         }
     }
 
     /// Writes the resolver's accumulated impulse for contact `index` of
-    /// [`NarrowPhase::contacts`] back into its persistent point; an index past the contacts is
-    /// ignored.
+    /// [`NarrowPhase::contacts`] back into its persistent point. An index past the contacts is
+    /// a caller's bug: ignored in release builds, a failed debug assertion otherwise.
     #[inline]
     pub fn store_impulse(&mut self, index: usize, impulse: Vec3) {
         let (Some(slot), Some(contact)) = (self.slots.get(index), self.contacts.get_mut(index))
         else {
+            debug_assert!(
+                false,
+                "impulse for contact {index} of {}",
+                self.contacts.len()
+            );
             return;
         };
         contact.impulse = impulse;

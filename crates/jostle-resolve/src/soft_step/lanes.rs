@@ -83,10 +83,20 @@ impl F8 {
         ])
     }
 
-    /// Lane-wise maximum (glam's: the second operand when either is NaN).
+    /// Lane-wise maximum: `self` where it is greater, else `o` (so `o` when either is NaN:
+    /// `max(F8::ZERO)` turns NaN into zero, the "do nothing" the kernels rely on).
     #[inline(always)]
     pub fn max(self, o: Self) -> Self {
-        halves!(|a, b| a.max(b), self, o)
+        // glam's `Vec4::max` is x86's `maxps`, exactly this rule; on other targets it may pass
+        // NaN through (NEON's `vmaxq_f32`), so the rule is spelled out there.
+        #[cfg(target_arch = "x86_64")]
+        {
+            halves!(|a, b| a.max(b), self, o)
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            Self::select(self.cmpgt(o), self, o)
+        }
     }
 
     /// Lane-wise square root.

@@ -8,12 +8,16 @@
 //! [`F8`]'s (`maxps` semantics for the maximum, ordered comparisons, exact division and square
 //! root, no fused multiply-add), so both give bit-identical results.
 //!
-//! The intrinsics need AVX. The type is private to the soft-step module and its values exist
-//! only inside the AVX kernels, where every operation is inlined into code compiled for AVX.
+//! The intrinsics need AVX, and the operations are safe trait methods, so the invariant of the
+//! soft-step module is: **`W8` and `WM8` are used only inside the functions the
+//! `with_best_lanes!` dispatch enters after detecting the CPU's features** (the kernels of
+//! [`super::solve`] and [`super::prepare::prepare_batches`]). Both types are visible to the
+//! soft-step module only, and the one way to reach them from prepared data, [`as_wide`], is an
+//! `unsafe fn` whose contract is that detection.
 
-// SAFETY (every `unsafe` block of this file): the AVX intrinsics are sound on a CPU with AVX,
-// and `W8`/`WM8` values are only created and used inside the AVX kernels of `super::solve`,
-// which are entered only after `is_x86_feature_detected!("avx")` (or "avx512vl") returned true.
+// SAFETY (every `unsafe` block of this file but `as_wide`'s): the AVX intrinsics are sound on a
+// CPU with AVX, and `W8`/`WM8` values are only created and used inside the functions entered
+// by `with_best_lanes!` after `avx_level()` detected AVX (see the module docs).
 use super::batch::{ManifoldLanes, PointLanes};
 use super::lanes::{F8, Lane, LaneMask, WIDTH};
 use std::arch::x86_64::*;
@@ -22,12 +26,12 @@ use std::ops::{Add, BitAnd, BitOr, Div, Index, IndexMut, Mul, Neg, Sub};
 /// Eight `f32` lanes in one AVX register.
 #[derive(Clone, Copy)]
 #[repr(C, align(32))]
-pub struct W8(__m256);
+pub(super) struct W8(__m256);
 
 /// Eight-lane mask: all bits set in a lane that holds.
 #[derive(Clone, Copy)]
 #[repr(C, align(32))]
-pub struct WM8(__m256);
+pub(super) struct WM8(__m256);
 
 const _: () = assert!(size_of::<W8>() == size_of::<F8>() && align_of::<W8>() == align_of::<F8>());
 
@@ -142,22 +146,23 @@ impl Lane for W8 {
         self.abs().cmplt(W8::splat(f32::INFINITY))
     }
 
-    // SSE's `cmpgt`/`cmplt`/`cmple` are the signalling ordered predicates, `cmpeq` the quiet
-    // ordered one; the masks they give are the same for every input.
     #[inline(always)]
     fn load_transposed(rows: [&[f32; WIDTH]; WIDTH]) -> [Self; WIDTH] {
-        // SAFETY: see the file header; unaligned loads of eight f32 each.
-        let load = |row: &[f32; WIDTH]| unsafe { W8(_mm256_loadu_ps(row.as_ptr())) };
-        Self::transpose([
-            load(rows[0]),
-            load(rows[1]),
-            load(rows[2]),
-            load(rows[3]),
-            load(rows[4]),
-            load(rows[5]),
-            load(rows[6]),
-            load(rows[7]),
-        ])
+        // SAFETY: see the file header; unaligned loads of eight f32 each. Written out, not a
+        // closure, which would not be compiled with the kernel's target features.
+        let rows = unsafe {
+            [
+                W8(_mm256_loadu_ps(rows[0].as_ptr())),
+                W8(_mm256_loadu_ps(rows[1].as_ptr())),
+                W8(_mm256_loadu_ps(rows[2].as_ptr())),
+                W8(_mm256_loadu_ps(rows[3].as_ptr())),
+                W8(_mm256_loadu_ps(rows[4].as_ptr())),
+                W8(_mm256_loadu_ps(rows[5].as_ptr())),
+                W8(_mm256_loadu_ps(rows[6].as_ptr())),
+                W8(_mm256_loadu_ps(rows[7].as_ptr())),
+            ]
+        };
+        Self::transpose(rows)
     }
 
     #[inline(always)]
@@ -204,6 +209,8 @@ impl Lane for W8 {
         }
     }
 
+    // SSE's `cmpgt`/`cmplt`/`cmple` are the signalling ordered predicates, `cmpeq` the quiet
+    // ordered one; the masks they give are the same for every input.
     compare!(cmpgt, _CMP_GT_OS);
     compare!(cmplt, _CMP_LT_OS);
     compare!(cmple, _CMP_LE_OS);
@@ -247,10 +254,12 @@ pub(super) enum AvxLevel {
     None,
 }
 
+/// The best [`AvxLevel`] of this CPU. The AVX-512 kernels are compiled with `avx512f`, which
+/// lets the compiler use AVX2 and FMA instructions too (it implies them), so those are checked
+/// as well rather than trusted to come with AVX-512 (a virtual machine may hide them).
 pub(super) fn avx_level() -> AvxLevel {
-    if std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512vl")
-    {
+    use std::arch::is_x86_feature_detected as has;
+    if has!("avx512f") && has!("avx512vl") && has!("avx2") && has!("fma") && has!("f16c") {
         AvxLevel::Avx512
     } else if std::arch::is_x86_feature_detected!("avx") {
         AvxLevel::Avx
@@ -267,8 +276,14 @@ const _: () = {
 };
 
 /// The batches viewed with [`W8`] lanes.
+///
+/// # Safety
+///
+/// The CPU must support AVX ([`avx_level`] is not [`AvxLevel::None`]): the view's values can
+/// only be operated on with AVX instructions, which the caller must run only in functions
+/// compiled for the detected features (the module docs' invariant). The cast itself is sound.
 #[inline(always)]
-pub(super) fn as_wide<'a>(
+pub(super) unsafe fn as_wide<'a>(
     manifolds: &'a mut [ManifoldLanes<F8>],
     points: &'a mut [PointLanes<F8>],
 ) -> (&'a mut [ManifoldLanes<W8>], &'a mut [PointLanes<W8>]) {

@@ -38,8 +38,8 @@
 /// 256-bit `W8` on the same storage read in place, inside a function compiled for AVX-512VL
 /// (its 32 vector registers hold a batch's velocities and a point's data without spills) or for
 /// AVX; elsewhere [`lanes::F8`] (two 128-bit halves). The lane operations are the same IEEE
-/// operations in every case (no fused multiply-add is introduced), so results are
-/// bit-identical on every CPU. Used by the kernels of [`solve`] and by
+/// operations in every case (no fused multiply-add is introduced), so on x86-64 the results are
+/// bit-identical whichever lanes run. Used by the kernels of [`solve`] and by
 /// [`prepare::prepare_batches`].
 macro_rules! with_best_lanes {
     ($imp:ident($manifolds:expr, $points:expr $(, $arg:ident: $ty:ty)*) -> $ret:ty) => {{
@@ -67,12 +67,15 @@ macro_rules! with_best_lanes {
             }
             match avx_level() {
                 AvxLevel::Avx512 => {
-                    let (manifolds, points) = as_wide(manifolds, points);
-                    // SAFETY: the CPU has been detected to support the enabled features.
+                    // SAFETY: the CPU has been detected to support the enabled features, and
+                    // the `W8` view is only used inside the function compiled for them.
+                    let (manifolds, points) = unsafe { as_wide(manifolds, points) };
+                    // SAFETY: as above.
                     return unsafe { avx512(manifolds, points $(, $arg)*) };
                 }
                 AvxLevel::Avx => {
-                    let (manifolds, points) = as_wide(manifolds, points);
+                    // SAFETY: as above, for AVX.
+                    let (manifolds, points) = unsafe { as_wide(manifolds, points) };
                     // SAFETY: as above.
                     return unsafe { avx(manifolds, points $(, $arg)*) };
                 }
