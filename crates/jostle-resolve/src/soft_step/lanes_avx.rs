@@ -259,14 +259,32 @@ pub(super) enum AvxLevel {
 /// as well rather than trusted to come with AVX-512 (a virtual machine may hide them).
 pub(super) fn avx_level() -> AvxLevel {
     use std::arch::is_x86_feature_detected as has;
-    if has!("avx512f") && has!("avx512vl") && has!("avx2") && has!("fma") && has!("f16c") {
-        AvxLevel::Avx512
-    } else if std::arch::is_x86_feature_detected!("avx") {
-        AvxLevel::Avx
-    } else {
-        AvxLevel::None
+    let detected =
+        if has!("avx512f") && has!("avx512vl") && has!("avx2") && has!("fma") && has!("f16c") {
+            AvxLevel::Avx512
+        } else if has!("avx") {
+            AvxLevel::Avx
+        } else {
+            AvxLevel::None
+        };
+    #[cfg(test)]
+    {
+        // Tests may ask for a lower level than the CPU has, never a higher one.
+        let capped = match (CAP.load(std::sync::atomic::Ordering::Relaxed), detected) {
+            (1, _) => AvxLevel::None,
+            (2, AvxLevel::Avx512) => AvxLevel::Avx,
+            _ => detected,
+        };
+        return capped;
     }
+    #[allow(unreachable_code)]
+    detected
 }
+
+/// Tests only: 0 = the detected level, 1 = the 128-bit lanes, 2 = at most AVX. The paths give
+/// identical results, so tests running meanwhile on other threads are unaffected.
+#[cfg(test)]
+pub(super) static CAP: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(0);
 
 const _: () = {
     assert!(size_of::<PointLanes<W8>>() == size_of::<PointLanes<F8>>());

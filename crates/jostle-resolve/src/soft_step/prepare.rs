@@ -276,8 +276,23 @@ mod tests {
             &scene.bodies,
             &params,
         );
-        assert_eq!(format!("{:?}", batches.points), format!("{points:?}"));
-        assert_eq!(format!("{:?}", batches.manifolds), format!("{manifolds:?}"));
+        let (expected_points, expected_manifolds) =
+            (format!("{points:?}"), format!("{manifolds:?}"));
+        // The detected level (used by `pack` above), then at most AVX, then 128-bit lanes.
+        for cap in [0, 2, 1] {
+            #[cfg(target_arch = "x86_64")]
+            super::super::lanes_avx::CAP.store(cap, std::sync::atomic::Ordering::Relaxed);
+            let mut again = Batches::default();
+            again.pack(&scene.contacts, &scene.bodies, 0.02, &params);
+            assert_eq!(format!("{:?}", again.points), expected_points, "cap {cap}");
+            assert_eq!(
+                format!("{:?}", again.manifolds),
+                expected_manifolds,
+                "cap {cap}"
+            );
+        }
+        #[cfg(target_arch = "x86_64")]
+        super::super::lanes_avx::CAP.store(0, std::sync::atomic::Ordering::Relaxed);
     }
 
     /// The lane-wise basis is `contact_basis`, bit for bit, for normals on both sides of the
