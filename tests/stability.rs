@@ -170,7 +170,7 @@ fn a_light_box_under_a_1000_times_heavier_one_neither_sinks_nor_tips() {
 /// quarter of the substep rate, or stiffened by their load, make stacks and pyramids unstable
 /// (RESULTS.md, "Stability").
 #[test]
-#[ignore = "known failure at the default settings: the heavy box sinks in and slides off; run with --ignored"]
+#[ignore = "known failure at the default settings: the heavy box sinks and slides off"]
 fn a_light_box_under_a_1000_times_heavier_one_neither_sinks_nor_tips_at_the_default_settings() {
     light_box_under_heavy_box(Some(ResolverChoice::SoftStep(Default::default())));
 }

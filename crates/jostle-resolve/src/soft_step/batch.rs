@@ -35,8 +35,8 @@ const COLOURS: u32 = 64;
 /// Marks a lane-point that holds no contact.
 pub const NO_SOURCE: u32 = u32::MAX;
 
-/// One contact point of each of eight manifolds, stored by lane, as [`prepare_point`](super::prepare::prepare_point) computes
-/// it; a padding lane holds zeros.
+/// One contact point of each of eight manifolds, stored by lane, as
+/// [`prepare_point`](super::prepare::prepare_point) computes it; a padding lane holds zeros.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C)]
 pub struct PointLanes<F = F8> {

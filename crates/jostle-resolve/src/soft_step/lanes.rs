@@ -1,17 +1,17 @@
 //! Eight-lane arithmetic for the soft-step kernels: one lane per contact manifold.
 //!
-//! [`F8`] is eight `f32` lanes held as two glam `Vec4`s, each a 128-bit SIMD register on
-//! x86-64 (SSE2) and aarch64 (NEON) and four plain floats elsewhere; it is what contacts are
-//! prepared and stored in. The kernels are generic over the [`Lane`] trait, and on x86-64 CPUs
-//! with AVX they run with the 256-bit type of the private `lanes_avx` module instead, reading the same
+//! [`F8`] is eight `f32` lanes held as two glam `Vec4`s, each a 128-bit SIMD register on x86-64
+//! (SSE2) and aarch64 (NEON) and four plain floats elsewhere; it is what contacts are prepared
+//! and stored in. The kernels are generic over the [`Lane`] trait, and on x86-64 CPUs with AVX
+//! they run with the 256-bit type of the private `lanes_avx` module instead, reading the same
 //! storage in place (one instruction per operation instead of two, identical results). Eight
 //! lanes rather than four because a batch's points are solved one after the other, each
-//! depending on the velocities the previous one left: one four-lane chain keeps the CPU
-//! waiting on latency, eight independent lanes keep it busy. [`V3x8`] is eight 3-vectors
-//! stored by component (x of the eight lanes, then y, then z), so a dot product of eight lanes
-//! is three multiplies and two adds and a cross product six multiplies and three subtractions,
-//! with no shuffles. [`Q8`] is eight quaternions stored the same way. Every operation is
-//! lane-wise IEEE arithmetic, so results do not depend on the lane a contact lands in.
+//! depending on the velocities the previous one left: one four-lane chain keeps the CPU waiting
+//! on latency, eight independent lanes keep it busy. [`V3x8`] is eight 3-vectors stored by
+//! component (x of the eight lanes, then y, then z), so a dot product of eight lanes is three
+//! multiplies and two adds and a cross product six multiplies and three subtractions, with no
+//! shuffles. [`Q8`] is eight quaternions stored the same way. Every operation is lane-wise IEEE
+//! arithmetic, so results do not depend on the lane a contact lands in.
 
 use jostle_math::glam::{BVec4A, Vec4};
 use jostle_math::{Quat, Vec3};
@@ -198,9 +198,9 @@ impl Neg for F8 {
     }
 }
 
-/// Eight-lane arithmetic as the kernels use it: [`F8`] (two 128-bit halves) everywhere, and
-/// on x86-64 CPUs with AVX a 256-bit type (the private `lanes_avx` module) inside kernels compiled for
-/// it. Every operation is lane-wise IEEE arithmetic with the same semantics in both, so the
+/// Eight-lane arithmetic as the kernels use it: [`F8`] (two 128-bit halves) everywhere, and on
+/// x86-64 CPUs with AVX a 256-bit type (the private `lanes_avx` module) inside kernels compiled
+/// for it. Every operation is lane-wise IEEE arithmetic with the same semantics in both, so the
 /// kernels give bit-identical results with either.
 pub trait Lane:
     Copy

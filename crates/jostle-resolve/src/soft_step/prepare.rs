@@ -1,13 +1,13 @@
 //! Preparing contact points eight lanes at a time, on the step-start poses.
 //!
-//! Everything the substep loop needs is computed here once per step, so the kernels touch
-//! only a [`PointLanes`] and the bodies' velocities and motion: the anchors, the normal and
-//! tangents (of [`jostle_math::contact_basis`], computed lane-wise; the convention of the stored impulses), the angular
-//! response of each body to a unit impulse along each direction (I⁻¹·(r × d), so no inertia
-//! matrix is loaded in the loop), the normal effective mass 1/(n·K·n), the inverse 2×2
-//! tangent effective mass (so one friction solve is exact for both tangents together), the
-//! softness that applies (static or dynamic stiffness), the approach velocity restitution
-//! reflects, and the warm-start impulse (the stored step impulse × 1/substeps).
+//! Everything the substep loop needs is computed here once per step, so the kernels touch only
+//! a [`PointLanes`] and the bodies' velocities and motion: the anchors, the normal and tangents
+//! (of [`jostle_math::contact_basis`], computed lane-wise; the convention of the stored
+//! impulses), the angular response of each body to a unit impulse along each direction
+//! (I⁻¹·(r × d), so no inertia matrix is loaded in the loop), the normal effective mass 1/(n·K·n), the
+//! inverse 2×2 tangent effective mass (so one friction solve is exact for both tangents
+//! together), the softness that applies (static or dynamic stiffness), the approach velocity
+//! restitution reflects, and the warm-start impulse (the stored step impulse × 1/substeps).
 //!
 //! The adjusted separation −penetration − (r_A − r_B)·n is stored so that the separation
 //! during the step is that plus (Δx_A + Δq_A·r_A − Δx_B − Δq_B·r_B)·n (Box2D's "adjusted
