@@ -19,7 +19,7 @@
 //! hold zero points: zero normal, zero effective mass, zero friction, bodies at the static
 //! entry, so every impulse they compute is exactly zero.
 
-use super::lanes::{F8, V3x8, WIDTH};
+use super::lanes::{F8, Lane, V3x8, WIDTH};
 use super::prepare::{PrepareParams, prepare_batches};
 use crate::{Contact, STATIC_BODY, SolverBody};
 

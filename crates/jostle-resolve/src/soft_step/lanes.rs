@@ -42,104 +42,21 @@ macro_rules! halves {
     }};
 }
 
-/// Applies a `Vec4` comparison to both halves.
+/// A `Vec4` comparison applied to both halves.
 macro_rules! compare {
     ($name:ident) => {
-        #[doc = concat!("Lane-wise `", stringify!($name), "`.")]
         #[inline(always)]
-        pub fn $name(self, o: Self) -> M8 {
+        fn $name(self, o: Self) -> M8 {
             M8([self.0[0].$name(o.0[0]), self.0[1].$name(o.0[1])])
         }
     };
 }
 
 impl F8 {
-    /// All lanes zero.
-    pub const ZERO: Self = Self([Vec4::ZERO; 2]);
-    /// All lanes one.
-    pub const ONE: Self = Self([Vec4::ONE; 2]);
-
-    /// All lanes `x`.
-    #[inline(always)]
-    pub fn splat(x: f32) -> Self {
-        Self([Vec4::splat(x); 2])
-    }
-
-    /// Lane i from `a[i]`.
-    #[inline(always)]
-    pub fn from_array(a: [f32; WIDTH]) -> Self {
-        Self([
-            Vec4::new(a[0], a[1], a[2], a[3]),
-            Vec4::new(a[4], a[5], a[6], a[7]),
-        ])
-    }
-
-    /// Lane-wise `if mask { t } else { f }`.
-    #[inline(always)]
-    pub fn select(mask: M8, t: Self, f: Self) -> Self {
-        Self([
-            Vec4::select(mask.0[0], t.0[0], f.0[0]),
-            Vec4::select(mask.0[1], t.0[1], f.0[1]),
-        ])
-    }
-
-    /// Lane-wise maximum: `self` where it is greater, else `o` (so `o` when either is NaN:
-    /// `max(F8::ZERO)` turns NaN into zero, the "do nothing" the kernels rely on).
-    #[inline(always)]
-    pub fn max(self, o: Self) -> Self {
-        // glam's `Vec4::max` is x86's `maxps`, exactly this rule; on other targets it may pass
-        // NaN through (NEON's `vmaxq_f32`), so the rule is spelled out there.
-        #[cfg(target_arch = "x86_64")]
-        {
-            halves!(|a, b| a.max(b), self, o)
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            Self::select(self.cmpgt(o), self, o)
-        }
-    }
-
-    /// Lane-wise square root.
-    #[inline(always)]
-    pub fn sqrt(self) -> Self {
-        halves!(|a| a.sqrt(), self)
-    }
-
-    /// Lane-wise 1/x.
-    #[inline(always)]
-    pub fn recip(self) -> Self {
-        halves!(|a| a.recip(), self)
-    }
-
-    /// Lane-wise |x|.
-    #[inline(always)]
-    pub fn abs(self) -> Self {
-        halves!(|a| a.abs(), self)
-    }
-
     /// The largest lane.
     #[inline(always)]
     pub fn max_element(self) -> f32 {
         self.0[0].max(self.0[1]).max_element()
-    }
-
-    /// Lanes that are finite.
-    #[inline(always)]
-    pub fn is_finite_mask(self) -> M8 {
-        M8([self.0[0].is_finite_mask(), self.0[1].is_finite_mask()])
-    }
-
-    compare!(cmpgt);
-    compare!(cmplt);
-    compare!(cmple);
-    compare!(cmpeq);
-}
-
-impl M8 {
-    /// Whether any lane is set.
-    #[inline(always)]
-    pub fn any(self) -> bool {
-        self.0[0].any() || self.0[1].any()
     }
 }
 
@@ -274,62 +191,74 @@ pub trait LaneMask: Copy + BitAnd<Output = Self> + BitOr<Output = Self> {
 
 impl Lane for F8 {
     type Mask = M8;
-    const ZERO: Self = F8::ZERO;
-    const ONE: Self = F8::ONE;
+    const ZERO: Self = Self([Vec4::ZERO; 2]);
+    const ONE: Self = Self([Vec4::ONE; 2]);
+
     #[inline(always)]
     fn splat(x: f32) -> Self {
-        F8::splat(x)
+        Self([Vec4::splat(x); 2])
     }
+
     #[inline(always)]
     fn from_array(a: [f32; WIDTH]) -> Self {
-        F8::from_array(a)
+        Self([
+            Vec4::new(a[0], a[1], a[2], a[3]),
+            Vec4::new(a[4], a[5], a[6], a[7]),
+        ])
     }
+
     #[inline(always)]
     fn select(mask: M8, t: Self, f: Self) -> Self {
-        F8::select(mask, t, f)
+        Self([
+            Vec4::select(mask.0[0], t.0[0], f.0[0]),
+            Vec4::select(mask.0[1], t.0[1], f.0[1]),
+        ])
     }
+
     #[inline(always)]
     fn max(self, o: Self) -> Self {
-        F8::max(self, o)
+        // glam's `Vec4::max` is x86's `maxps`, exactly the trait's rule; on other targets it
+        // may pass NaN through (NEON's `vmaxq_f32`), so the rule is spelled out there.
+        #[cfg(target_arch = "x86_64")]
+        {
+            halves!(|a, b| a.max(b), self, o)
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            Self::select(self.cmpgt(o), self, o)
+        }
     }
+
     #[inline(always)]
     fn sqrt(self) -> Self {
-        F8::sqrt(self)
+        halves!(|a| a.sqrt(), self)
     }
+
     #[inline(always)]
     fn recip(self) -> Self {
-        F8::recip(self)
+        halves!(|a| a.recip(), self)
     }
+
     #[inline(always)]
     fn abs(self) -> Self {
-        F8::abs(self)
+        halves!(|a| a.abs(), self)
     }
+
     #[inline(always)]
     fn is_finite_mask(self) -> M8 {
-        F8::is_finite_mask(self)
+        M8([self.0[0].is_finite_mask(), self.0[1].is_finite_mask()])
     }
-    #[inline(always)]
-    fn cmpgt(self, o: Self) -> M8 {
-        F8::cmpgt(self, o)
-    }
-    #[inline(always)]
-    fn cmplt(self, o: Self) -> M8 {
-        F8::cmplt(self, o)
-    }
-    #[inline(always)]
-    fn cmple(self, o: Self) -> M8 {
-        F8::cmple(self, o)
-    }
-    #[inline(always)]
-    fn cmpeq(self, o: Self) -> M8 {
-        F8::cmpeq(self, o)
-    }
+
+    compare!(cmpgt);
+    compare!(cmplt);
+    compare!(cmple);
+    compare!(cmpeq);
 }
 
 impl LaneMask for M8 {
     #[inline(always)]
     fn any(self) -> bool {
-        M8::any(self)
+        self.0[0].any() || self.0[1].any()
     }
 }
 

@@ -37,36 +37,35 @@ struct Motion<F> {
     rotation: Q8<F>,
 }
 
-/// The states of the eight lanes' bodies.
+/// One 8-float row of each lane's body: `motion` picks [`BodyState::motion_row`], else
+/// [`BodyState::velocity_row`].
 #[inline(always)]
-fn lane_states(states: &[BodyState], idx: [u32; LANES]) -> [&BodyState; LANES] {
-    // Written out: an array `map` is a closure, which would not be inlined into the kernel.
+fn lane_rows(states: &[BodyState], idx: [u32; LANES], motion: bool) -> [&[f32; 8]; LANES] {
+    let row = |i: u32| {
+        let s = &states[i as usize];
+        if motion {
+            s.motion_row()
+        } else {
+            s.velocity_row()
+        }
+    };
+    // Written out: an array `map` would not be inlined into the kernel. The closure holds no
+    // lane operations, so it needs none of the kernel's target features.
     [
-        &states[idx[0] as usize],
-        &states[idx[1] as usize],
-        &states[idx[2] as usize],
-        &states[idx[3] as usize],
-        &states[idx[4] as usize],
-        &states[idx[5] as usize],
-        &states[idx[6] as usize],
-        &states[idx[7] as usize],
+        row(idx[0]),
+        row(idx[1]),
+        row(idx[2]),
+        row(idx[3]),
+        row(idx[4]),
+        row(idx[5]),
+        row(idx[6]),
+        row(idx[7]),
     ]
 }
 
 #[inline(always)]
 fn gather_velocities<F: Lane>(states: &[BodyState], idx: [u32; LANES]) -> Velocities<F> {
-    let s = lane_states(states, idx);
-    let rows = [
-        s[0].velocity_row(),
-        s[1].velocity_row(),
-        s[2].velocity_row(),
-        s[3].velocity_row(),
-        s[4].velocity_row(),
-        s[5].velocity_row(),
-        s[6].velocity_row(),
-        s[7].velocity_row(),
-    ];
-    let [lx, ly, lz, _, ax, ay, az, _] = F::load_transposed(rows);
+    let [lx, ly, lz, _, ax, ay, az, _] = F::load_transposed(lane_rows(states, idx, false));
     Velocities {
         linear: V3x8 {
             x: lx,
@@ -83,18 +82,7 @@ fn gather_velocities<F: Lane>(states: &[BodyState], idx: [u32; LANES]) -> Veloci
 
 #[inline(always)]
 fn gather_motion<F: Lane>(states: &[BodyState], idx: [u32; LANES]) -> Motion<F> {
-    let s = lane_states(states, idx);
-    let rows = [
-        s[0].motion_row(),
-        s[1].motion_row(),
-        s[2].motion_row(),
-        s[3].motion_row(),
-        s[4].motion_row(),
-        s[5].motion_row(),
-        s[6].motion_row(),
-        s[7].motion_row(),
-    ];
-    let [qx, qy, qz, qw, px, py, pz, _] = F::load_transposed(rows);
+    let [qx, qy, qz, qw, px, py, pz, _] = F::load_transposed(lane_rows(states, idx, true));
     Motion {
         position: V3x8 {
             x: px,
