@@ -84,6 +84,9 @@ pub enum Generator {
         /// Density (kg/m³). Default 1000.
         #[serde(default = "density")]
         density: f32,
+        /// Density of the top box (kg/m³), for heavy-on-light stacks. Default: `density`.
+        #[serde(default)]
+        top_density: Option<f32>,
         /// Name prefix. Default "stack".
         #[serde(default)]
         name: Option<String>,
@@ -236,9 +239,13 @@ impl Generator {
                 origin,
                 friction,
                 density,
+                top_density,
                 ..
             } => {
                 count("count", *n)?;
+                if let Some(t) = top_density {
+                    positive("top_density", *t)?;
+                }
                 if !(half_extents.is_finite() && half_extents.min_element() > 0.0) {
                     return Err((
                         "half_extents".into(),
@@ -357,18 +364,18 @@ impl Generator {
                 origin,
                 friction,
                 density,
+                top_density,
                 name,
             } => {
                 let name = name.as_deref().unwrap_or("stack");
                 for i in 0..*count {
                     let centre = *origin + Vec3::new(0.0, he.y * (2 * i + 1) as f32, 0.0);
-                    out.push(cuboid(
-                        format!("{name}-{i}"),
-                        *he,
-                        centre,
-                        *friction,
-                        *density,
-                    ));
+                    let d = if i + 1 == *count {
+                        top_density.unwrap_or(*density)
+                    } else {
+                        *density
+                    };
+                    out.push(cuboid(format!("{name}-{i}"), *he, centre, *friction, d));
                 }
             }
             Self::Wall {

@@ -29,9 +29,11 @@
 
 mod error;
 mod generators;
+mod perturb;
 
 pub use error::SceneError;
 pub use generators::Generator;
+pub use perturb::Perturb;
 
 use crate::body_desc::{BodyDesc, MassSpec};
 use crate::settings::{ResolverChoice, WorldSettings};
@@ -89,6 +91,11 @@ pub struct Scene {
     /// Generated bodies, added after `bodies`.
     #[serde(default)]
     pub generators: Vec<Generator>,
+    /// A seeded perturbation of the generated bodies' start ([`Perturb`]): each is shifted
+    /// sideways and turned a little, and lifted so that none overlaps. Default: none, the
+    /// generators' exact layout.
+    #[serde(default)]
+    pub perturb: Option<Perturb>,
     /// The camera renderers use (`jostle run --render`). Default: none, the renderer frames
     /// the scene itself.
     #[serde(default)]
@@ -330,6 +337,10 @@ impl Scene {
                 setting(&format!("generators[{i}].{field}"), message)
             })?;
         }
+        if let Some(p) = &self.perturb {
+            p.validate()
+                .map_err(|(field, message)| setting(&field, message))?;
+        }
         if let Some(analytic) = &self.analytic {
             analytic
                 .validate()
@@ -376,8 +387,12 @@ impl Scene {
                 error: e,
             })?);
         }
+        let first_generated = out.len();
         for g in &self.generators {
             out.extend(g.bodies());
+        }
+        if let Some(p) = &self.perturb {
+            p.apply(&mut out[first_generated..]);
         }
         Ok(out)
     }

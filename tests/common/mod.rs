@@ -1,5 +1,8 @@
-//! Shared builders for the physics validation tests: small worlds with closed-form answers.
+//! Shared builders for the physics validation tests: small worlds with closed-form answers, and
+//! the stability family ([`family`]).
 #![allow(dead_code)]
+
+pub mod family;
 
 use jostle::{
     BodyDesc, BodyHandle, MillingtonSettings, Quat, ResolverChoice, ShapeDesc, SoftStepSettings,

@@ -1,0 +1,190 @@
+//! The stability family of issue 15 side by side with rapier3d 0.36 at its defaults, in one
+//! run: the scenes of `tests/common/family.rs` (columns, planar and 3D pyramids, a wall, heavy
+//! boxes on light ones; several sizes, frictions and seeded starts), each built in both
+//! engines from the same body descriptions (positions, rotations, half extents, densities,
+//! frictions; jostle's ground half-space is a fixed 4,000 m cuboid in rapier3d with its top
+//! face at y = 0; friction combines as the mean in rapier3d and both sides carry the case's
+//! value). Sleeping is off in both. jostle runs its soft-step resolver at its defaults (the
+//! engine's default resolver, Millington, lets even a 10-box column fall). Each run is 20 s at 60 Hz; the table prints the lateral
+//! drift between 2 s and 20 s, the sink per contact layer, the largest penetration after 2 s,
+//! the bodies that moved more than half a box sideways, and the median ms per step, for both
+//! engines.
+//!
+//! Run: `cargo bench --bench stability_family` (several minutes; `FAMILY=base` runs only the
+//! base family, `FAMILY=variations` only the variations). With `--test` (`cargo test
+//! --benches`) only a short smoke run is made.
+
+#[path = "../tests/common/family.rs"]
+mod family;
+
+use family::{Case, Outcome};
+use jostle::{ResolverChoice, SoftStepSettings, Vec3};
+use rapier3d::prelude as rp;
+use std::time::Instant;
+
+/// The case in rapier3d at its defaults, sleeping disabled.
+fn rapier_world(case: &Case) -> (rp::PhysicsWorld, Vec<rp::RigidBodyHandle>) {
+    let scene = family::parse(case);
+    let mut world = rp::PhysicsWorld {
+        gravity: rp::Vector::new(0.0, -9.81, 0.0),
+        ..Default::default()
+    };
+    world.integration_parameters.dt = 1.0 / 60.0;
+    let mut handles = Vec::new();
+    for desc in scene.body_descs().expect("scene bodies") {
+        let friction = desc.material.friction;
+        if desc.fixed {
+            assert_eq!(
+                desc.shape,
+                jostle::ShapeDesc::HalfSpace { normal: Vec3::Y },
+                "{}: the only fixed body is the ground",
+                case.name
+            );
+            world.insert(
+                rp::RigidBodyBuilder::fixed().translation(rp::Vector::new(0.0, -1.0, 0.0)),
+                rp::ColliderBuilder::cuboid(2000.0, 1.0, 2000.0).friction(friction),
+            );
+            continue;
+        }
+        let jostle::ShapeDesc::Cuboid { half_extents: h } = desc.shape else {
+            panic!("{}: only cuboids", case.name);
+        };
+        let jostle::MassSpec::Density(density) = desc.mass else {
+            panic!("{}: densities only", case.name);
+        };
+        let p = desc.position;
+        let q = desc.rotation;
+        let (handle, _) = world.insert(
+            rp::RigidBodyBuilder::dynamic()
+                .translation(rp::Vector::new(p.x, p.y, p.z))
+                .rotation(rp::Rotation::from_xyzw(q.x, q.y, q.z, q.w).to_scaled_axis())
+                .can_sleep(false),
+            rp::ColliderBuilder::cuboid(h.x, h.y, h.z)
+                .density(density)
+                .friction(friction),
+        );
+        handles.push(handle);
+    }
+    (world, handles)
+}
+
+/// The rapier3d run of `case`, measured as `family::run` measures jostle's.
+fn run_rapier(case: &Case, seconds: f32) -> Outcome {
+    let scene = family::parse(case);
+    let mut nominal = scene.clone();
+    nominal.perturb = None;
+    let rest: Vec<Vec3> = nominal
+        .body_descs()
+        .unwrap()
+        .into_iter()
+        .filter(|d| !d.fixed)
+        .map(|d| d.position)
+        .collect();
+    let half = scene
+        .body_descs()
+        .unwrap()
+        .iter()
+        .filter_map(|d| match d.shape {
+            jostle::ShapeDesc::Cuboid { half_extents } if !d.fixed => Some(half_extents.y),
+            _ => None,
+        })
+        .fold(f32::MAX, f32::min);
+    let (mut world, handles) = rapier_world(case);
+    let positions = |w: &rp::PhysicsWorld| -> Vec<Vec3> {
+        handles
+            .iter()
+            .map(|&h| {
+                let t = w.bodies[h].translation();
+                Vec3::new(t.x, t.y, t.z)
+            })
+            .collect()
+    };
+    let steps = (seconds * 60.0).round() as usize;
+    let start = positions(&world);
+    let mut at_settle = start.clone();
+    let mut penetration = 0.0f32;
+    let mut times = Vec::with_capacity(steps);
+    for step in 1..=steps {
+        let t = Instant::now();
+        world.step();
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+        if step == 120 {
+            at_settle = positions(&world);
+        }
+        if step > 120 {
+            for pair in world.narrow_phase.contact_pairs() {
+                for m in pair.manifolds() {
+                    for p in &m.points {
+                        penetration = penetration.max(-p.dist);
+                    }
+                }
+            }
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    let end = positions(&world);
+    let drift = end
+        .iter()
+        .zip(&at_settle)
+        .map(|(p, q)| (*p - *q).with_y(0.0).length())
+        .fold(0.0, f32::max);
+    let sink = end
+        .iter()
+        .zip(&rest)
+        .map(|(p, r)| r.y - p.y)
+        .fold(0.0, f32::max);
+    let moved = end
+        .iter()
+        .zip(&start)
+        .filter(|(p, q)| (**p - **q).with_y(0.0).length() > half)
+        .count();
+    Outcome {
+        drift,
+        sink_per_layer: sink / case.layers.max(1) as f32,
+        penetration,
+        ms_per_step: times[times.len() / 2],
+        moved,
+    }
+}
+
+fn row(engine: &str, o: &Outcome) -> String {
+    format!(
+        "{engine} | {:.2} | {:.3} | {:.2} | {} | {:.3} | {}",
+        o.drift * 1e3,
+        o.sink_per_layer * 1e3,
+        o.penetration * 1e3,
+        o.moved,
+        o.ms_per_step,
+        if o.stands() { "yes" } else { "no" }
+    )
+}
+
+fn main() {
+    let smoke = std::env::args().any(|a| a == "--test");
+    let which = std::env::var("FAMILY").unwrap_or_default();
+    let mut cases = Vec::new();
+    if which != "variations" {
+        cases.extend(family::base());
+    }
+    if which != "base" {
+        cases.extend(family::variations());
+    }
+    let seconds = if smoke { 0.5 } else { 20.0 };
+    if smoke {
+        cases.truncate(2);
+    }
+    println!(
+        "| case | engine | lateral drift 2–20 s (mm) | sink per layer (mm) | largest penetration (mm) | bodies moved | ms/step | meets the criterion |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|---|");
+    for case in &cases {
+        let j = family::run(
+            case,
+            seconds,
+            Some(ResolverChoice::SoftStep(SoftStepSettings::default())),
+        );
+        let r = run_rapier(case, seconds);
+        println!("| {} | {} |", case.name, row("jostle", &j));
+        println!("| {} | {} |", case.name, row("rapier3d", &r));
+    }
+}

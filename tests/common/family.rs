@@ -1,0 +1,341 @@
+//! The stability family of issue 15, as scene files: columns, planar and 3D pyramids, a
+//! running-bond wall, and heavy boxes on light ones, each at any box size, friction and seeded
+//! perturbation of the start. Shared by `tests/stability_family.rs` and the side-by-side bench
+//! `benches/stability_family.rs` (included there by path), so both run the same scenes.
+//!
+//! Every case runs at the scene's defaults but for sleeping (off, so standing still is the
+//! resolver's doing) and reports what the criterion needs: the largest lateral drift of any
+//! body between 2 s and the end, the sink per contact layer (the deepest any body ends below its
+//! nominal resting height, over the layers of contacts under the top), the largest penetration
+//! after 2 s, and the median time per step.
+#![allow(dead_code)]
+
+use jostle::scene::Scene;
+use jostle::{ResolverChoice, Vec3, World};
+use std::time::Instant;
+
+/// The criterion of issue 15: lateral drift under 1 cm.
+pub const MAX_DRIFT: f32 = 0.01;
+/// The criterion of issue 15: sink under 1 mm per contact layer.
+pub const MAX_SINK_PER_LAYER: f32 = 0.001;
+
+/// One scene of the family.
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// Short name for tables.
+    pub name: String,
+    /// The scene, as a RON file's text.
+    pub ron: String,
+    /// Contact layers under the top body (a column of n boxes has n).
+    pub layers: u32,
+}
+
+/// Variations every family member takes: box half size, friction, and the seed of a perturbed
+/// start (`None`: the generator's exact layout).
+#[derive(Clone, Copy, Debug)]
+pub struct Variant {
+    /// Half the box size (m).
+    pub half: f32,
+    /// Friction of boxes and ground.
+    pub friction: f32,
+    /// Seed of a start perturbed by up to 3 mm and 0.3°.
+    pub seed: Option<u64>,
+}
+
+impl Default for Variant {
+    fn default() -> Self {
+        Self {
+            half: 0.5,
+            friction: 0.5,
+            seed: None,
+        }
+    }
+}
+
+impl Variant {
+    fn suffix(&self) -> String {
+        let mut s = String::new();
+        if self.half != 0.5 {
+            s += &format!(" {}m", 2.0 * self.half);
+        }
+        if self.friction != 0.5 {
+            s += &format!(" μ{}", self.friction);
+        }
+        if let Some(seed) = self.seed {
+            s += &format!(" seed{seed}");
+        }
+        s
+    }
+
+    fn perturb(&self) -> String {
+        self.seed
+            .map_or(String::new(), |s| format!("perturb: Perturb(seed: {s}),"))
+    }
+}
+
+fn scene(name: &str, v: &Variant, generator: &str) -> String {
+    format!(
+        "Scene(name: \"{name}\", steps: 1200, sleep: (enabled: false), {perturb}
+           bodies: [Body(name: \"ground\", shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true,
+                         friction: {mu})],
+           generators: [{generator}])",
+        perturb = v.perturb(),
+        mu = v.friction,
+    )
+}
+
+/// A column of `n` boxes.
+pub fn column(n: u32, v: Variant) -> Case {
+    let name = format!("column {n}{}", v.suffix());
+    let g = format!(
+        "Stack(count: {n}, half_extents: ({h}, {h}, {h}), friction: {mu})",
+        h = v.half,
+        mu = v.friction
+    );
+    Case {
+        ron: scene(&name, &v, &g),
+        name,
+        layers: n,
+    }
+}
+
+/// A planar pyramid of `rows` rows.
+pub fn pyramid(rows: u32, v: Variant) -> Case {
+    let name = format!("pyramid {rows}{}", v.suffix());
+    let g = format!(
+        "Pyramid(rows: {rows}, half_extent: {h}, friction: {mu})",
+        h = v.half,
+        mu = v.friction
+    );
+    Case {
+        ron: scene(&name, &v, &g),
+        name,
+        layers: rows,
+    }
+}
+
+/// A 3D pyramid of `layers` square layers.
+pub fn pyramid3d(layers: u32, v: Variant) -> Case {
+    let name = format!("3D pyramid {layers}{}", v.suffix());
+    let g = format!(
+        "Pyramid3D(layers: {layers}, half_extent: {h}, friction: {mu})",
+        h = v.half,
+        mu = v.friction
+    );
+    Case {
+        ron: scene(&name, &v, &g),
+        name,
+        layers,
+    }
+}
+
+/// A running-bond wall, `columns` bricks long and `rows` high; bricks are 2·half × half ×
+/// half long, high and deep.
+pub fn wall(columns: u32, rows: u32, v: Variant) -> Case {
+    let name = format!("wall {columns}x{rows}{}", v.suffix());
+    let h = v.half;
+    let g = format!(
+        "Wall(columns: {columns}, rows: {rows}, half_extents: ({}, {}, {}), friction: {mu})",
+        h,
+        0.5 * h,
+        0.5 * h,
+        mu = v.friction
+    );
+    Case {
+        ron: scene(&name, &v, &g),
+        name,
+        layers: rows,
+    }
+}
+
+/// `n` − 1 light boxes with one `ratio` times denser on top (`n` = 2: a pair).
+pub fn heavy_on_light(ratio: f32, n: u32, v: Variant) -> Case {
+    let name = if n == 2 {
+        format!("1:{ratio} pair{}", v.suffix())
+    } else {
+        format!("1:{ratio} column {n}{}", v.suffix())
+    };
+    let g = format!(
+        "Stack(count: {n}, half_extents: ({h}, {h}, {h}), friction: {mu}, density: 1000.0, \
+         top_density: {top})",
+        h = v.half,
+        mu = v.friction,
+        top = 1000.0 * ratio
+    );
+    Case {
+        ron: scene(&name, &v, &g),
+        name,
+        layers: n,
+    }
+}
+
+/// What one run of a case measured.
+#[derive(Clone, Copy, Debug)]
+pub struct Outcome {
+    /// Largest horizontal displacement of any body between 2 s and the end (m).
+    pub drift: f32,
+    /// Deepest any body ends below its nominal resting height, per contact layer (m).
+    pub sink_per_layer: f32,
+    /// Largest penetration after 2 s (m).
+    pub penetration: f32,
+    /// Median wall time of a step (ms).
+    pub ms_per_step: f64,
+    /// Bodies that ended more than half a box sideways from where they started (fell).
+    pub moved: usize,
+}
+
+impl Outcome {
+    /// Whether the case meets issue 15's criterion.
+    pub fn stands(&self) -> bool {
+        self.drift < MAX_DRIFT && self.sink_per_layer < MAX_SINK_PER_LAYER && self.moved == 0
+    }
+}
+
+/// The parsed scene of a case.
+pub fn parse(case: &Case) -> Scene {
+    Scene::parse(&case.ron, &case.name).unwrap_or_else(|e| panic!("{}: {e}", case.name))
+}
+
+/// Runs `case` for `seconds` at 60 Hz with the scene's settings, or with `resolver`.
+pub fn run(case: &Case, seconds: f32, resolver: Option<ResolverChoice>) -> Outcome {
+    let scene = parse(case);
+    let mut nominal = scene.clone();
+    nominal.perturb = None;
+    let rest: Vec<Vec3> = nominal
+        .body_descs()
+        .unwrap()
+        .into_iter()
+        .filter(|d| !d.fixed)
+        .map(|d| d.position)
+        .collect();
+    let mut settings = scene.settings();
+    if let Some(r) = resolver {
+        settings.resolver = r;
+    }
+    let mut world = scene.build_with(settings).unwrap();
+    let half = scene
+        .body_descs()
+        .unwrap()
+        .iter()
+        .filter(|d| !d.fixed)
+        .map(|d| match d.shape {
+            jostle::ShapeDesc::Cuboid { half_extents } => half_extents.y,
+            _ => 0.5,
+        })
+        .fold(f32::MAX, f32::min);
+    measure(&mut world, &rest, case.layers, seconds, half)
+}
+
+fn positions(world: &World) -> Vec<Vec3> {
+    world
+        .bodies()
+        .filter(|(_, _, b)| !b.is_fixed())
+        .map(|(_, _, b)| b.position)
+        .collect()
+}
+
+fn measure(world: &mut World, rest: &[Vec3], layers: u32, seconds: f32, half: f32) -> Outcome {
+    let dt = 1.0 / 60.0;
+    let steps = (seconds / dt).round() as usize;
+    let settle = 120;
+    let start = positions(world);
+    let mut at_settle = start.clone();
+    let mut penetration = 0.0f32;
+    let mut times = Vec::with_capacity(steps);
+    for step in 1..=steps {
+        let t = Instant::now();
+        world.step(dt).unwrap();
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+        if step == settle {
+            at_settle = positions(world);
+        }
+        if step > settle {
+            penetration = penetration.max(world.max_penetration());
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    let end = positions(world);
+    let drift = end
+        .iter()
+        .zip(&at_settle)
+        .map(|(p, q)| (*p - *q).with_y(0.0).length())
+        .fold(0.0, f32::max);
+    let sink = end
+        .iter()
+        .zip(rest)
+        .map(|(p, r)| r.y - p.y)
+        .fold(0.0, f32::max);
+    let moved = end
+        .iter()
+        .zip(&start)
+        .filter(|(p, q)| (**p - **q).with_y(0.0).length() > half)
+        .count();
+    Outcome {
+        drift,
+        sink_per_layer: sink / layers.max(1) as f32,
+        penetration,
+        ms_per_step: times[times.len() / 2],
+        moved,
+    }
+}
+
+/// The family of issue 15 at unit boxes, μ 0.5, exact starts: columns of 10, 20, 40, 60;
+/// pyramids of 20, 40, 60 rows; 3D pyramids of 10 and 20 layers; a 20 × 10 wall; heavy on
+/// light pairs and 5-box columns at 1:10 to 1:10,000.
+pub fn base() -> Vec<Case> {
+    let v = Variant::default();
+    let mut out = Vec::new();
+    for n in [10, 20, 40, 60] {
+        out.push(column(n, v));
+    }
+    for rows in [20, 40, 60] {
+        out.push(pyramid(rows, v));
+    }
+    for layers in [10, 20] {
+        out.push(pyramid3d(layers, v));
+    }
+    out.push(wall(20, 10, v));
+    for ratio in [10.0, 100.0, 1000.0, 10000.0] {
+        out.push(heavy_on_light(ratio, 2, v));
+        out.push(heavy_on_light(ratio, 5, v));
+    }
+    out
+}
+
+/// The variations of a few members: 0.1 m and 10 m boxes, μ 0.3 and 0.9, two seeds.
+pub fn variations() -> Vec<Case> {
+    let mut out = Vec::new();
+    let variants = [
+        Variant {
+            half: 0.05,
+            ..Variant::default()
+        },
+        Variant {
+            half: 5.0,
+            ..Variant::default()
+        },
+        Variant {
+            friction: 0.3,
+            ..Variant::default()
+        },
+        Variant {
+            friction: 0.9,
+            ..Variant::default()
+        },
+        Variant {
+            seed: Some(1),
+            ..Variant::default()
+        },
+        Variant {
+            seed: Some(2),
+            ..Variant::default()
+        },
+    ];
+    for v in variants {
+        out.push(column(20, v));
+        out.push(pyramid(20, v));
+        out.push(pyramid3d(10, v));
+        out.push(heavy_on_light(100.0, 2, v));
+    }
+    out
+}
