@@ -17,10 +17,9 @@
 #[path = "../tests/common/family.rs"]
 mod family;
 
-use family::{Case, Outcome};
+use family::{Case, Subject};
 use jostle::{ResolverChoice, SoftStepSettings, Vec3};
 use rapier3d::prelude as rp;
-use std::time::Instant;
 
 /// The case in rapier3d at its defaults, sleeping disabled.
 fn rapier_world(case: &Case) -> (rp::PhysicsWorld, Vec<rp::RigidBodyHandle>) {
@@ -68,95 +67,36 @@ fn rapier_world(case: &Case) -> (rp::PhysicsWorld, Vec<rp::RigidBodyHandle>) {
     (world, handles)
 }
 
-/// The rapier3d run of `case`, measured as `family::run` measures jostle's.
-fn run_rapier(case: &Case, seconds: f32) -> Outcome {
-    let scene = family::parse(case);
-    let mut nominal = scene.clone();
-    nominal.perturb = None;
-    let rest: Vec<Vec3> = nominal
-        .body_descs()
-        .unwrap()
-        .into_iter()
-        .filter(|d| !d.fixed)
-        .map(|d| d.position)
-        .collect();
-    let half = scene
-        .body_descs()
-        .unwrap()
-        .iter()
-        .filter_map(|d| match d.shape {
-            jostle::ShapeDesc::Cuboid { half_extents } if !d.fixed => Some(half_extents.y),
-            _ => None,
-        })
-        .fold(f32::MAX, f32::min);
-    let (mut world, handles) = rapier_world(case);
-    let positions = |w: &rp::PhysicsWorld| -> Vec<Vec3> {
-        handles
+/// A case in rapier3d, for [`family::measure`].
+struct Rapier {
+    world: rp::PhysicsWorld,
+    boxes: Vec<rp::RigidBodyHandle>,
+}
+
+impl Subject for Rapier {
+    fn step(&mut self) {
+        self.world.step();
+    }
+    fn positions(&self) -> Vec<Vec3> {
+        self.boxes
             .iter()
             .map(|&h| {
-                let t = w.bodies[h].translation();
+                let t = self.world.bodies[h].translation();
                 Vec3::new(t.x, t.y, t.z)
             })
             .collect()
-    };
-    let steps = (seconds * 60.0).round() as usize;
-    let start = positions(&world);
-    let mut at_settle = start.clone();
-    let mut penetration = 0.0f32;
-    let mut times = Vec::with_capacity(steps);
-    for step in 1..=steps {
-        let t = Instant::now();
-        world.step();
-        times.push(t.elapsed().as_secs_f64() * 1e3);
-        if step == 120 {
-            at_settle = positions(&world);
-        }
-        if step > 120 {
-            for pair in world.narrow_phase.contact_pairs() {
-                for m in pair.manifolds() {
-                    for p in &m.points {
-                        penetration = penetration.max(-p.dist);
-                    }
+    }
+    fn penetration(&self) -> f32 {
+        let mut deepest = 0.0f32;
+        for pair in self.world.narrow_phase.contact_pairs() {
+            for m in pair.manifolds() {
+                for p in &m.points {
+                    deepest = deepest.max(-p.dist);
                 }
             }
         }
+        deepest
     }
-    times.sort_by(f64::total_cmp);
-    let end = positions(&world);
-    let drift = end
-        .iter()
-        .zip(&at_settle)
-        .map(|(p, q)| (*p - *q).with_y(0.0).length())
-        .fold(0.0, f32::max);
-    let sink = end
-        .iter()
-        .zip(&rest)
-        .map(|(p, r)| r.y - p.y)
-        .fold(0.0, f32::max);
-    let moved = end
-        .iter()
-        .zip(&start)
-        .filter(|(p, q)| (**p - **q).with_y(0.0).length() > half)
-        .count();
-    Outcome {
-        drift,
-        sink_per_layer: sink / case.layers.max(1) as f32,
-        penetration,
-        ms_per_step: times[times.len() / 2],
-        moved,
-    }
-}
-
-fn row(engine: &str, o: &Outcome) -> String {
-    format!(
-        "{engine} | {:.2} | {:.3} | {:.2} | {} | {:.3} | {}",
-        o.drift * 1e3,
-        o.sink_per_layer * 1e3,
-        o.penetration * 1e3,
-        o.moved,
-        o.ms_per_step,
-        if o.stands() { "yes" } else { "no" }
-    )
 }
 
 fn main() {
@@ -183,8 +123,14 @@ fn main() {
             seconds,
             Some(ResolverChoice::SoftStep(SoftStepSettings::default())),
         );
-        let r = run_rapier(case, seconds);
-        println!("| {} | {} |", case.name, row("jostle", &j));
-        println!("| {} | {} |", case.name, row("rapier3d", &r));
+        let (world, boxes) = rapier_world(case);
+        let r = family::measure(
+            &mut Rapier { world, boxes },
+            &family::nominal(case),
+            case.layers,
+            seconds,
+        );
+        println!("| {} | jostle | {} |", case.name, j.cells());
+        println!("| {} | rapier3d | {} |", case.name, r.cells());
     }
 }

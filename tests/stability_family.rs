@@ -63,15 +63,6 @@ fn family_table() {
     for case in family::base().iter().chain(&family::variations()) {
         let o = family::run(case, 20.0, resolver.clone());
         assert!(o.drift.is_finite() && o.sink_per_layer.is_finite());
-        println!(
-            "| {} | {:.2} | {:.3} | {:.2} | {} | {:.3} | {} |",
-            case.name,
-            o.drift * 1e3,
-            o.sink_per_layer * 1e3,
-            o.penetration * 1e3,
-            o.moved,
-            o.ms_per_step,
-            if o.stands() { "yes" } else { "no" }
-        );
+        println!("| {} | {} |", case.name, o.cells());
     }
 }

@@ -73,100 +73,68 @@ impl Variant {
     }
 }
 
-fn scene(name: &str, v: &Variant, generator: &str) -> String {
-    format!(
+/// The case `name` (the variant's suffix appended): the ground and `generator`, a
+/// generator's RON text, whose top stands on `layers` layers of contacts.
+fn case(name: &str, v: &Variant, generator: &str, layers: u32) -> Case {
+    let name = format!("{name}{}", v.suffix());
+    let ron = format!(
         "Scene(name: \"{name}\", steps: 1200, sleep: (enabled: false), {perturb}
            bodies: [Body(name: \"ground\", shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true,
                          friction: {mu})],
            generators: [{generator}])",
         perturb = v.perturb(),
         mu = v.friction,
-    )
+    );
+    Case { name, ron, layers }
 }
 
 /// A column of `n` boxes.
 pub fn column(n: u32, v: Variant) -> Case {
-    let name = format!("column {n}{}", v.suffix());
-    let g = format!(
-        "Stack(count: {n}, half_extents: ({h}, {h}, {h}), friction: {mu})",
-        h = v.half,
-        mu = v.friction
-    );
-    Case {
-        ron: scene(&name, &v, &g),
-        name,
-        layers: n,
-    }
+    let (h, mu) = (v.half, v.friction);
+    let g = format!("Stack(count: {n}, half_extents: ({h}, {h}, {h}), friction: {mu})");
+    case(&format!("column {n}"), &v, &g, n)
 }
 
 /// A planar pyramid of `rows` rows.
 pub fn pyramid(rows: u32, v: Variant) -> Case {
-    let name = format!("pyramid {rows}{}", v.suffix());
-    let g = format!(
-        "Pyramid(rows: {rows}, half_extent: {h}, friction: {mu})",
-        h = v.half,
-        mu = v.friction
-    );
-    Case {
-        ron: scene(&name, &v, &g),
-        name,
-        layers: rows,
-    }
+    let (h, mu) = (v.half, v.friction);
+    let g = format!("Pyramid(rows: {rows}, half_extent: {h}, friction: {mu})");
+    case(&format!("pyramid {rows}"), &v, &g, rows)
 }
 
 /// A 3D pyramid of `layers` square layers.
 pub fn pyramid3d(layers: u32, v: Variant) -> Case {
-    let name = format!("3D pyramid {layers}{}", v.suffix());
-    let g = format!(
-        "Pyramid3D(layers: {layers}, half_extent: {h}, friction: {mu})",
-        h = v.half,
-        mu = v.friction
-    );
-    Case {
-        ron: scene(&name, &v, &g),
-        name,
-        layers,
-    }
+    let (h, mu) = (v.half, v.friction);
+    let g = format!("Pyramid3D(layers: {layers}, half_extent: {h}, friction: {mu})");
+    case(&format!("3D pyramid {layers}"), &v, &g, layers)
 }
 
 /// A running-bond wall, `columns` bricks long and `rows` high; bricks are 2·half × half ×
 /// half long, high and deep.
 pub fn wall(columns: u32, rows: u32, v: Variant) -> Case {
-    let name = format!("wall {columns}x{rows}{}", v.suffix());
-    let h = v.half;
+    let (h, mu) = (v.half, v.friction);
     let g = format!(
-        "Wall(columns: {columns}, rows: {rows}, half_extents: ({}, {}, {}), friction: {mu})",
-        h,
+        "Wall(columns: {columns}, rows: {rows}, half_extents: ({h}, {}, {}), friction: {mu})",
         0.5 * h,
-        0.5 * h,
-        mu = v.friction
+        0.5 * h
     );
-    Case {
-        ron: scene(&name, &v, &g),
-        name,
-        layers: rows,
-    }
+    case(&format!("wall {columns}x{rows}"), &v, &g, rows)
 }
 
 /// `n` − 1 light boxes with one `ratio` times denser on top (`n` = 2: a pair).
 pub fn heavy_on_light(ratio: f32, n: u32, v: Variant) -> Case {
-    let name = if n == 2 {
-        format!("1:{ratio} pair{}", v.suffix())
-    } else {
-        format!("1:{ratio} column {n}{}", v.suffix())
-    };
+    let (h, mu) = (v.half, v.friction);
     let g = format!(
         "Stack(count: {n}, half_extents: ({h}, {h}, {h}), friction: {mu}, density: 1000.0, \
-         top_density: {top})",
-        h = v.half,
-        mu = v.friction,
-        top = 1000.0 * ratio
+         top_density: {})",
+        1000.0 * ratio
     );
-    Case {
-        ron: scene(&name, &v, &g),
-        name,
-        layers: n,
-    }
+    let name = if n == 2 {
+        format!("1:{ratio} pair")
+    } else {
+        format!("1:{ratio} column {n}")
+    };
+    case(&name, &v, &g, n)
 }
 
 /// What one run of a case measured.
@@ -191,90 +159,138 @@ impl Outcome {
     }
 }
 
+impl Outcome {
+    /// The outcome as the cells of a markdown table row: drift, sink per layer, penetration
+    /// (mm), bodies moved, ms/step, and whether it meets the criterion.
+    pub fn cells(&self) -> String {
+        format!(
+            "{:.2} | {:.3} | {:.2} | {} | {:.3} | {}",
+            self.drift * 1e3,
+            self.sink_per_layer * 1e3,
+            self.penetration * 1e3,
+            self.moved,
+            self.ms_per_step,
+            if self.stands() { "yes" } else { "no" }
+        )
+    }
+}
+
 /// The parsed scene of a case.
 pub fn parse(case: &Case) -> Scene {
     Scene::parse(&case.ron, &case.name).unwrap_or_else(|e| panic!("{}: {e}", case.name))
 }
 
-/// Runs `case` for `seconds` at 60 Hz with the scene's settings, or with `resolver`.
-pub fn run(case: &Case, seconds: f32, resolver: Option<ResolverChoice>) -> Outcome {
-    let scene = parse(case);
-    let mut nominal = scene.clone();
-    nominal.perturb = None;
-    let rest: Vec<Vec3> = nominal
+/// Where a case's dynamic bodies rest when nothing moves: the generators' exact layout (no
+/// perturbation), and the smallest half height of a box, the "half a box" that counts a
+/// body as fallen.
+pub struct Nominal {
+    /// Resting centres of the dynamic bodies, in the scene's order.
+    pub rest: Vec<Vec3>,
+    /// Smallest half height of a dynamic box (m).
+    pub half: f32,
+}
+
+/// The nominal layout of `case`.
+pub fn nominal(case: &Case) -> Nominal {
+    let mut scene = parse(case);
+    scene.perturb = None;
+    let dynamic: Vec<_> = scene
         .body_descs()
         .unwrap()
         .into_iter()
         .filter(|d| !d.fixed)
-        .map(|d| d.position)
         .collect();
-    let mut settings = scene.settings();
-    if let Some(r) = resolver {
-        settings.resolver = r;
-    }
-    let mut world = scene.build_with(settings).unwrap();
-    let half = scene
-        .body_descs()
-        .unwrap()
+    let half = dynamic
         .iter()
-        .filter(|d| !d.fixed)
         .map(|d| match d.shape {
             jostle::ShapeDesc::Cuboid { half_extents } => half_extents.y,
             _ => 0.5,
         })
         .fold(f32::MAX, f32::min);
-    measure(&mut world, &rest, case.layers, seconds, half)
+    Nominal {
+        rest: dynamic.iter().map(|d| d.position).collect(),
+        half,
+    }
 }
 
-fn positions(world: &World) -> Vec<Vec3> {
-    world
-        .bodies()
-        .filter(|(_, _, b)| !b.is_fixed())
-        .map(|(_, _, b)| b.position)
-        .collect()
+/// An engine running one case: what the measurement needs of it.
+pub trait Subject {
+    /// One step of 1/60 s.
+    fn step(&mut self);
+    /// The dynamic bodies' centres, in the scene's order.
+    fn positions(&self) -> Vec<Vec3>;
+    /// The deepest penetration of the last step (m).
+    fn penetration(&self) -> f32;
 }
 
-fn measure(world: &mut World, rest: &[Vec3], layers: u32, seconds: f32, half: f32) -> Outcome {
-    let dt = 1.0 / 60.0;
-    let steps = (seconds / dt).round() as usize;
+impl Subject for World {
+    fn step(&mut self) {
+        World::step(self, 1.0 / 60.0).unwrap();
+    }
+    fn positions(&self) -> Vec<Vec3> {
+        self.bodies()
+            .filter(|(_, _, b)| !b.is_fixed())
+            .map(|(_, _, b)| b.position)
+            .collect()
+    }
+    fn penetration(&self) -> f32 {
+        self.max_penetration()
+    }
+}
+
+/// Runs `case` in jostle for `seconds` with the scene's settings, or with `resolver`.
+pub fn run(case: &Case, seconds: f32, resolver: Option<ResolverChoice>) -> Outcome {
+    let scene = parse(case);
+    let mut settings = scene.settings();
+    if let Some(r) = resolver {
+        settings.resolver = r;
+    }
+    let mut world = scene.build_with(settings).unwrap();
+    measure(&mut world, &nominal(case), case.layers, seconds)
+}
+
+/// Steps `subject` for `seconds` at 60 Hz and measures the outcome against `nominal`.
+pub fn measure(subject: &mut dyn Subject, nominal: &Nominal, layers: u32, seconds: f32) -> Outcome {
+    let steps = (seconds * 60.0).round() as usize;
     let settle = 120;
-    let start = positions(world);
+    let start = subject.positions();
     let mut at_settle = start.clone();
     let mut penetration = 0.0f32;
     let mut times = Vec::with_capacity(steps);
     for step in 1..=steps {
         let t = Instant::now();
-        world.step(dt).unwrap();
+        subject.step();
         times.push(t.elapsed().as_secs_f64() * 1e3);
         if step == settle {
-            at_settle = positions(world);
+            at_settle = subject.positions();
         }
         if step > settle {
-            penetration = penetration.max(world.max_penetration());
+            penetration = penetration.max(subject.penetration());
         }
     }
     times.sort_by(f64::total_cmp);
-    let end = positions(world);
+    let end = subject.positions();
+    let sideways = |p: &Vec3, q: &Vec3| (*p - *q).with_y(0.0).length();
     let drift = end
         .iter()
         .zip(&at_settle)
-        .map(|(p, q)| (*p - *q).with_y(0.0).length())
+        .map(|(p, q)| sideways(p, q))
         .fold(0.0, f32::max);
     let sink = end
         .iter()
-        .zip(rest)
+        .zip(&nominal.rest)
         .map(|(p, r)| r.y - p.y)
         .fold(0.0, f32::max);
     let moved = end
         .iter()
         .zip(&start)
-        .filter(|(p, q)| (**p - **q).with_y(0.0).length() > half)
+        .filter(|(p, q)| sideways(p, q) > nominal.half)
         .count();
     Outcome {
         drift,
         sink_per_layer: sink / layers.max(1) as f32,
         penetration,
-        ms_per_step: times[times.len() / 2],
+        ms_per_step: times.get(times.len() / 2).copied().unwrap_or(0.0),
         moved,
     }
 }
