@@ -19,7 +19,9 @@
 //! threshold 0.3; body `name` "", `position` origin, `rotation` identity (x, y, z, w), zero
 //! velocities, `density` 1000 kg/m³ unless `mass` (kg) is given, `friction` 0.5,
 //! `restitution` 0, damping 0, `can_sleep` true, `fixed` false, `ccd` Auto. `generators` add many bodies
-//! from a few parameters (pyramids, stacks, walls, grids of piles). An optional `camera`
+//! from a few parameters (pyramids, stacks, walls, grids of piles); an optional `perturb`
+//! ([`Perturb`]) shifts and turns them a little from a seed, so a file gives a reproducible
+//! perturbed start. An optional `camera`
 //! ([`Camera`]) fixes the view of renderers; without one they frame the scene themselves. An
 //! optional `analytic` ([`crate::bench::Analytic`]) declares the scene's closed form, which
 //! `jostle bench` compares the run against.
