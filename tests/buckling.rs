@@ -13,9 +13,10 @@
 //! November 2026: 4 substeps, 30 Hz between boxes, 60 Hz against the ground), so they keep
 //! explaining what soft contacts do whatever the resolver's defaults become.
 
-use jostle::{
-    BodyDesc, BodyHandle, ResolverChoice, ShapeDesc, SoftStepSettings, Vec3, World, WorldSettings,
-};
+mod common;
+
+use common::family::{self, Variant};
+use jostle::{BodyHandle, ResolverChoice, SoftStepSettings, World};
 use nalgebra::{DMatrix, SymmetricEigen};
 
 const DT: f32 = 1.0 / 60.0;
@@ -33,37 +34,20 @@ fn soft(substeps: u32, contact_hertz: f32, static_hertz: f32) -> SoftStepSetting
     }
 }
 
-/// A column of `n` unit boxes (1000 kg/m³, μ 0.5) on the ground, sleeping off.
+/// The family's column of `n` unit boxes (1000 kg/m³, μ 0.5, sleeping off) with `settings`,
+/// and its top box.
 fn column(n: u32, settings: SoftStepSettings) -> (World, BodyHandle) {
-    let mut world = World::new(WorldSettings {
-        resolver: ResolverChoice::SoftStep(settings),
-        sleep: jostle::layers::sleep::SleepSettings {
-            enabled: false,
-            ..Default::default()
-        },
-        ..WorldSettings::default()
-    });
-    world
-        .add_body(
-            BodyDesc::fixed("ground", ShapeDesc::HalfSpace { normal: Vec3::Y })
-                .with_material(0.5, 0.0),
-        )
+    let scene = family::parse(&family::column(n, Variant::default()));
+    let mut world_settings = scene.settings();
+    world_settings.resolver = ResolverChoice::SoftStep(settings);
+    let world = scene.build_with(world_settings).unwrap();
+    let top = world
+        .bodies()
+        .filter(|(_, _, b)| !b.is_fixed())
+        .map(|(h, _, _)| h)
+        .last()
         .unwrap();
-    let h = HALF as f32;
-    let mut top = None;
-    for i in 0..n {
-        let desc = BodyDesc::dynamic(
-            format!("box-{i}"),
-            ShapeDesc::Cuboid {
-                half_extents: Vec3::splat(h),
-            },
-        )
-        .at(Vec3::new(0.0, h + 2.0 * h * i as f32, 0.0))
-        .with_density(DENSITY as f32)
-        .with_material(0.5, 0.0);
-        top = Some(world.add_body(desc).unwrap());
-    }
-    (world, top.unwrap())
+    (world, top)
 }
 
 /// The lowest eigenvalue μ of M⁻¹(K − G) for the column as rigid blocks hinged at the

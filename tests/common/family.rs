@@ -3,8 +3,8 @@
 //! perturbation of the start. Shared by `tests/stability_family.rs` and the side-by-side bench
 //! `benches/stability_family.rs` (included there by path), so both run the same scenes.
 //!
-//! Every case runs at the scene's defaults but for sleeping (off, so standing still is the
-//! resolver's doing) and reports what the criterion needs: the largest lateral drift of any
+//! Every case runs with sleeping off (so standing still is the resolver's doing), with the
+//! scene's settings or the resolver a caller names, and reports what the criterion needs: the largest lateral drift of any
 //! body between 2 s and the end, the sink per contact layer (the deepest any body ends below its
 //! nominal resting height, over the layers of contacts under the top), the largest penetration
 //! after 2 s, and the median time per step.
