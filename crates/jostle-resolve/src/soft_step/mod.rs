@@ -12,17 +12,23 @@
 //!    eight manifolds at once ([`lanes`]).
 //! 2. per substep: integrate gravity (and the implicit gyroscopic torque) into velocities;
 //!    warm start (apply the accumulated impulses); solve every contact once with its soft bias,
-//!    the separation recomputed from the bodies' motion since the start of the step;
-//!    integrate velocities into position and rotation deltas; relax (solve again without
+//!    the separation recomputed from the bodies' motion since the start of the step, the
+//!    push-out of deep or unloaded overlap going to pseudo velocities; integrate velocities
+//!    (and, once, the pseudo velocities) into position and rotation deltas; relax (solve again without
 //!    bias). Friction is solved in the relax pass only, unless
 //!    [`SoftStepSettings::friction_in_bias_pass`] is set.
 //! 3. restitution, skipped when no contact has e > 0;
 //! 4. store the impulses and the remaining penetration in the contacts, the poses and
 //!    velocities in the bodies.
 //!
-//! Unlike the Millington resolver there is no position projection: overlap is removed by the
-//! soft constraint's bias velocity, which the relax pass then takes back out, so resolving
-//! overlap does not make things bounce. The contacts are solved simultaneously (in a fixed
+//! Unlike the Millington resolver there is no position projection: a resting contact's
+//! overlap (its spring's compression under its load, plus
+//! [`SoftStepSettings::push_out_slop`]) is removed by the soft constraint's bias velocity,
+//! which the relax pass then takes back out; deeper overlap, and the overlap of bodies that
+//! start overlapping or hit fast, is pushed out by split impulses, pseudo velocities that move
+//! the bodies within the substep and are then discarded ([`solve::solve`],
+//! [`integrate::integrate_positions`]). So resolving overlap neither makes things bounce nor
+//! adds kinetic energy. The contacts are solved simultaneously (in a fixed
 //! order, colour by colour, to convergence over the substeps), so a Newton's cradle of
 //! touching balls does not give the textbook one-ball-out answer; momentum and energy are
 //! still conserved.
@@ -99,7 +105,7 @@ pub mod softness;
 pub mod solve;
 
 pub use batch::Batches;
-pub use body_state::BodyState;
+pub use body_state::{BodyState, PseudoRow};
 pub use prepare::PrepareParams;
 pub use settings::SoftStepSettings;
 pub use softness::Softness;
@@ -121,6 +127,8 @@ pub struct SoftStepResolver {
     batches: Batches,
     /// Normal impulses before the restitution pass, restored after it.
     saved_impulse: Vec<lanes::F8>,
+    /// Each body's pseudo velocities of the current substep ([`PseudoRow`]).
+    pseudo: Vec<PseudoRow>,
 }
 
 impl SoftStepResolver {
@@ -142,6 +150,8 @@ impl SoftStepResolver {
     fn load_bodies(&mut self, bodies: &[SolverBody]) {
         self.states.clear();
         self.states.extend(bodies.iter().map(BodyState::from_body));
+        self.pseudo.clear();
+        self.pseudo.resize(bodies.len(), [0.0; 8]);
         if let Some(s) = self.states.get_mut(STATIC_BODY as usize) {
             *s = BodyState::STATIC;
         }
@@ -235,14 +245,20 @@ impl Resolver for SoftStepResolver {
             solve::solve(
                 &mut self.batches,
                 &mut self.states,
-                inv_h,
-                push_out,
-                self.settings.friction_in_bias_pass || self.settings.relax_iterations == 0,
+                &mut self.pseudo,
+                solve::BiasedPass {
+                    inv_h,
+                    max_push_out: push_out,
+                    slop: self.settings.push_out_slop,
+                    resting_speed: self.settings.restitution_threshold,
+                    friction: self.settings.friction_in_bias_pass
+                        || self.settings.relax_iterations == 0,
+                },
             );
             solve_time += t.elapsed();
 
             let t = Instant::now();
-            integrate::integrate_positions(&mut self.states, h);
+            integrate::integrate_positions(&mut self.states, &mut self.pseudo, h);
             integrate_time += t.elapsed();
 
             let t = Instant::now();

@@ -33,6 +33,16 @@ pub struct SoftStepSettings {
     /// Largest speed at which the soft bias pushes overlapping bodies apart (m/s). Default 3.
     /// Bounds the energy a deep overlap can inject.
     pub max_push_out: f32,
+    /// Overlap (m) beyond its spring's static compression under its current load that a
+    /// resting contact (loaded, and approaching slower than `restitution_threshold` at the
+    /// start of the step) still pushes out through real velocity, as a plain soft contact.
+    /// Default 0.02 (the speculative margin). Overlap deeper than that, and all overlap of a
+    /// contact that carries no load or hit fast (bodies that start overlapping, an impact), is
+    /// pushed out through pseudo velocities that move the bodies but are discarded after each
+    /// substep (split impulses), so separating overlapping bodies adds no kinetic energy. Much
+    /// less than the default lets loaded stacks rock (a 1 kg box under 100 kg drifts 18 mm in
+    /// 20 s at 0.005, 0.5 mm at 0.02).
+    pub push_out_slop: f32,
     /// Gap (m) up to which a separated contact takes part as a speculative constraint (it
     /// stops the bodies from closing more than the gap within a substep). Default 0.02, the
     /// narrow phase's prediction distance. Contacts with a larger gap are ignored.
@@ -72,6 +82,7 @@ impl Default for SoftStepSettings {
             static_hertz: 60.0,
             damping_ratio: 10.0,
             max_push_out: 3.0,
+            push_out_slop: 0.02,
             speculative_margin: 0.02,
             restitution_threshold: 1.0,
             restitution_iterations: 64,
@@ -104,6 +115,7 @@ impl SoftStepSettings {
         non_negative("static_hertz", self.static_hertz)?;
         non_negative("damping_ratio", self.damping_ratio)?;
         non_negative("max_push_out", self.max_push_out)?;
+        non_negative("push_out_slop", self.push_out_slop)?;
         non_negative("speculative_margin", self.speculative_margin)?;
         non_negative("restitution_threshold", self.restitution_threshold)
     }
