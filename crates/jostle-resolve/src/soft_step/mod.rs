@@ -251,6 +251,7 @@ impl Resolver for SoftStepResolver {
                     max_push_out: push_out,
                     slop: self.settings.push_out_slop,
                     resting_speed: self.settings.restitution_threshold,
+                    gravity_speed: ctx.gravity.length() * h,
                     friction: self.settings.friction_in_bias_pass
                         || self.settings.relax_iterations == 0,
                 },

@@ -430,6 +430,9 @@ pub struct BiasedPass {
     pub slop: f32,
     /// Approach speed (m/s) at the start of the step below which a loaded contact is resting.
     pub resting_speed: f32,
+    /// Speed (m/s) gravity adds in one substep, |g|·h: a resting spring's equilibrium sits
+    /// that much bias speed beyond its static compression.
+    pub gravity_speed: f32,
     /// Solve friction too ([`super::SoftStepSettings::friction_in_bias_pass`]).
     pub friction: bool,
 }
@@ -441,13 +444,14 @@ pub struct BiasedPass {
 /// (s < 0 on overlap, b clamped to the push-out speed) and s_i·λ the bleed that makes it a
 /// spring. Under a steady load λ the spring settles where the two balance, b = −s_i·λ (s_i·λ
 /// is exactly the bias of the spring's static compression λ/(h·k)): that much bias is the
-/// spring carrying its load and stays in the real impulse, as in the plain soft step. So does
-/// the bias of up to `slop` (m) more overlap on a resting contact (one that carries a load,
-/// λ > 0, and approached slower than `resting_speed` at the start of the step), so a loaded
-/// spring keeps reacting to changes of its load through real velocity: the discrete
-/// equilibrium itself sits about g·h/β deeper (4.5 mm at the defaults), and with every bias
-/// beyond the static compression in pseudo velocities the 20-row pyramid drifts 34 mm in 10 s
-/// instead of 1 mm; with a 5 mm slop the 1:100 pair drifts 18 mm instead of 0.5 mm.
+/// spring carrying its load and stays in the real impulse, as in the plain soft step. On a
+/// resting contact (one that carries a load, λ > 0, and approached slower than
+/// `resting_speed` at the start of the step) so does an allowance of m·s_m·(β·`slop` + |g|·h):
+/// the discrete equilibrium sits one substep of gravity's speed deeper (|g|·h/β, 4.5 mm at the
+/// defaults), and a loaded spring must keep reacting to changes of its load through real
+/// velocity. With every bias beyond the static compression in pseudo velocities the 20-row
+/// pyramid drifts 34 mm in 10 s instead of 1 mm; with the slop alone (5 mm) and no gravity
+/// term the 1:100 pair drifts 18 mm instead of 0.5 mm.
 ///
 /// Any overlap deeper than that, and all overlap of a contact that carries no load or hit
 /// fast (bodies that start overlapping, an impact), would be pushed out by the excess bias as
@@ -471,6 +475,7 @@ fn solve_batch_split<F: Lane>(
         max_push_out,
         slop,
         resting_speed,
+        gravity_speed,
         friction,
     } = pass;
     let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
@@ -478,6 +483,7 @@ fn solve_batch_split<F: Lane>(
     let push_out = F::splat(-max_push_out);
     let resting_speed = F::splat(-resting_speed);
     let slop = F::splat(slop);
+    let gravity_speed = F::splat(gravity_speed);
     for p in points.iter_mut() {
         let s = separation(p, &motion_a, &motion_b);
         let speculative = s.cmpgt(F::ZERO);
@@ -486,9 +492,9 @@ fn solve_batch_split<F: Lane>(
         // The bias as an impulse (≤ 0 on overlap), and the part of it the load explains.
         let bias = soft_mass * (p.bias_rate * s).max(push_out);
         let resting = p.normal_impulse.cmpgt(F::ZERO) & resting_speed.cmplt(p.relative_velocity);
-        let slop = F::select(resting, slop, F::ZERO);
+        let allowance = F::select(resting, p.bias_rate * slop + gravity_speed, F::ZERO);
         let vn = pair.relative_velocity(p).dot(p.normal);
-        let carried = bias.max(-bleed - soft_mass * p.bias_rate * slop);
+        let carried = bias.max(-bleed - soft_mass * allowance);
         let excess = F::select(speculative, F::ZERO, bias - carried);
 
         let rigid = -p.normal_mass * (vn + s * inv_h);
@@ -537,9 +543,8 @@ fn solve_impl<F: Lane>(
 
 wide_kernel! {
     /// One biased pass with split impulses ([`solve_batch_split`]): every contact with its
-    /// own softness, the push-out of overlap beyond the load's (and beyond `slop`, m, on
-    /// contacts approaching slower than `resting_speed`, m/s; at most `max_push_out`, m/s) in
-    /// the pseudo
+    /// own softness, the push-out of overlap beyond the load's (and beyond the allowance of
+    /// resting contacts; at most `max_push_out`, m/s) in the pseudo
     /// velocities `pseudo` (one [`PseudoRow`] per body, zero at the start of the pass), with
     /// friction when `friction` is set (see [`super::SoftStepSettings::friction_in_bias_pass`]).
     /// `inv_h` is 1/substep (1/s).
@@ -719,6 +724,7 @@ mod tests {
             max_push_out: 3.0,
             slop: 0.02,
             resting_speed: 1.0,
+            gravity_speed: 9.81 / 240.0,
             friction: false,
         };
         let (batches, states) = pile();
