@@ -29,10 +29,9 @@ impl Default for ResolverChoice {
     /// The Millington resolver, for now. The soft-step resolver is measured far ahead of it on
     /// stacks (release, 60 Hz, sleep off: the 20-row pyramid costs 1.39 ms/step and stands
     /// still, final kinetic energy 1.7e-7 J, against 58.5 ms/step and a collapse, 4.98e5 J;
-    /// a 20-box tower drifts 5 cm against 3.8 m), but it adds kinetic energy when it pushes
-    /// apart bodies that start overlapping (≈ 0.01% in the property tests, bounded by its
-    /// push-out speed), which breaks the engine's "no energy from nothing" contract. It becomes
-    /// the default once its push-out no longer feeds the real velocity (split impulses).
+    /// a 20-box tower drifts 5 cm against 3.8 m), and its push-out of overlapping bodies no
+    /// longer feeds the real velocity (split impulses: random overlapping scenes never gain
+    /// kinetic energy). Making it the default is the next step of issue 15.
     fn default() -> Self {
         Self::Millington(MillingtonSettings::default())
     }

@@ -41,14 +41,19 @@ struct Motion<F> {
 /// [`BodyState::velocity_row`].
 #[inline(always)]
 fn lane_rows(states: &[BodyState], idx: [u32; LANES], motion: bool) -> [&[f32; 8]; LANES] {
-    let row = |i: u32| {
+    rows_of(idx, |i: u32| {
         let s = &states[i as usize];
         if motion {
             s.motion_row()
         } else {
             s.velocity_row()
         }
-    };
+    })
+}
+
+/// `row(i)` for each lane's body index.
+#[inline(always)]
+fn rows_of<'a>(idx: [u32; LANES], row: impl Fn(u32) -> &'a [f32; 8]) -> [&'a [f32; 8]; LANES] {
     // Written out: an array `map` would not be inlined into the kernel. The closure holds no
     // lane operations, so it needs none of the kernel's target features.
     [
@@ -63,21 +68,51 @@ fn lane_rows(states: &[BodyState], idx: [u32; LANES], motion: bool) -> [&[f32; 8
     ]
 }
 
+impl<F: Lane> Velocities<F> {
+    /// From the transposed rows of [`BodyState::velocity_row`]'s layout: linear in 0–2,
+    /// angular in 4–6.
+    #[inline(always)]
+    fn from_columns([lx, ly, lz, _, ax, ay, az, _]: [F; 8]) -> Self {
+        Self {
+            linear: V3x8 {
+                x: lx,
+                y: ly,
+                z: lz,
+            },
+            angular: V3x8 {
+                x: ax,
+                y: ay,
+                z: az,
+            },
+        }
+    }
+
+    /// Stores each lane's velocities into `row(&mut bodies[i])` of its body i in the same
+    /// layout, leaving lanes 3 and 7 of each row alone (a body's 1/m and flags in
+    /// [`BodyState`]); the static entry is never written.
+    #[inline(always)]
+    fn store<B>(&self, idx: [u32; LANES], bodies: &mut [B], row: impl Fn(&mut B) -> &mut [f32; 8]) {
+        let rows = F::transpose([
+            self.linear.x,
+            self.linear.y,
+            self.linear.z,
+            F::ZERO,
+            self.angular.x,
+            self.angular.y,
+            self.angular.z,
+            F::ZERO,
+        ]);
+        for (lane, &i) in idx.iter().enumerate() {
+            if i != STATIC_BODY {
+                rows[lane].store_skipping_3_and_7(row(&mut bodies[i as usize]));
+            }
+        }
+    }
+}
+
 #[inline(always)]
 fn gather_velocities<F: Lane>(states: &[BodyState], idx: [u32; LANES]) -> Velocities<F> {
-    let [lx, ly, lz, _, ax, ay, az, _] = F::load_transposed(lane_rows(states, idx, false));
-    Velocities {
-        linear: V3x8 {
-            x: lx,
-            y: ly,
-            z: lz,
-        },
-        angular: V3x8 {
-            x: ax,
-            y: ay,
-            z: az,
-        },
-    }
+    Velocities::from_columns(F::load_transposed(lane_rows(states, idx, false)))
 }
 
 #[inline(always)]
@@ -102,70 +137,19 @@ fn gather_motion<F: Lane>(states: &[BodyState], idx: [u32; LANES]) -> Motion<F> 
 
 #[inline(always)]
 fn scatter_velocities<F: Lane>(states: &mut [BodyState], idx: [u32; LANES], v: &Velocities<F>) {
-    // Lanes 3 and 7 of each row are the body's 1/m and flags, which the store leaves alone.
-    let rows = F::transpose([
-        v.linear.x,
-        v.linear.y,
-        v.linear.z,
-        F::ZERO,
-        v.angular.x,
-        v.angular.y,
-        v.angular.z,
-        F::ZERO,
-    ]);
-    for (lane, &i) in idx.iter().enumerate() {
-        if i != STATIC_BODY {
-            rows[lane].store_skipping_3_and_7(states[i as usize].velocity_row_mut());
-        }
-    }
+    v.store(idx, states, BodyState::velocity_row_mut);
 }
 
 /// The pseudo velocities of eight bodies, by lane: rows of [`PseudoRow`] (see
 /// [`solve`]).
 #[inline(always)]
 fn gather_pseudo<F: Lane>(pseudo: &[PseudoRow], idx: [u32; LANES]) -> Velocities<F> {
-    let row = |i: u32| &pseudo[i as usize];
-    let [lx, ly, lz, _, ax, ay, az, _] = F::load_transposed([
-        row(idx[0]),
-        row(idx[1]),
-        row(idx[2]),
-        row(idx[3]),
-        row(idx[4]),
-        row(idx[5]),
-        row(idx[6]),
-        row(idx[7]),
-    ]);
-    Velocities {
-        linear: V3x8 {
-            x: lx,
-            y: ly,
-            z: lz,
-        },
-        angular: V3x8 {
-            x: ax,
-            y: ay,
-            z: az,
-        },
-    }
+    Velocities::from_columns(F::load_transposed(rows_of(idx, |i| &pseudo[i as usize])))
 }
 
 #[inline(always)]
 fn scatter_pseudo<F: Lane>(pseudo: &mut [PseudoRow], idx: [u32; LANES], v: &Velocities<F>) {
-    let rows = F::transpose([
-        v.linear.x,
-        v.linear.y,
-        v.linear.z,
-        F::ZERO,
-        v.angular.x,
-        v.angular.y,
-        v.angular.z,
-        F::ZERO,
-    ]);
-    for (lane, &i) in idx.iter().enumerate() {
-        if i != STATIC_BODY {
-            rows[lane].store_skipping_3_and_7(&mut pseudo[i as usize]);
-        }
-    }
+    v.store(idx, pseudo, |row| row);
 }
 
 /// A batch's two sides during a kernel: velocities loaded, written back by [`Pair::store`].
