@@ -11,7 +11,8 @@ use crate::SolverBody;
 use jostle_math::{Quat, Vec3};
 
 /// The pseudo velocities of one body during a substep, as one row of eight floats: linear
-/// (m/s) in 0–2, angular (rad/s) in 4–6, zeros in 3 and 7. They carry the push-out of overlap
+/// (m/s) in 0–2, angular (rad/s) in 4–6, in 3 a mark (1) that the row was written this
+/// substep, 0 in 7. They carry the push-out of overlap
 /// ([`super::solve::solve`]): the bodies move with them in the substep, then they are cleared,
 /// so pushing overlap out never becomes real velocity (split impulses, Catto 2006; Box2D
 /// v2.1's and Bullet's position correction).

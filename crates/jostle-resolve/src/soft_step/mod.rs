@@ -14,8 +14,8 @@
 //!    warm start (apply the accumulated impulses); solve every contact once with its soft bias,
 //!    the separation recomputed from the bodies' motion since the start of the step, the
 //!    push-out of deep or unloaded overlap going to pseudo velocities; integrate velocities
-//!    (and, once, the pseudo velocities) into position and rotation deltas; relax (solve again without
-//!    bias). Friction is solved in the relax pass only, unless
+//!    (and the pseudo velocities, which are then cleared) into position and rotation deltas;
+//!    relax (solve again without bias). Friction is solved in the relax pass only, unless
 //!    [`SoftStepSettings::friction_in_bias_pass`] is set.
 //! 3. restitution, skipped when no contact has e > 0;
 //! 4. store the impulses and the remaining penetration in the contacts, the poses and
@@ -23,12 +23,12 @@
 //!
 //! Unlike the Millington resolver there is no position projection: a resting contact's
 //! overlap (its spring's compression under its load, plus
-//! [`SoftStepSettings::push_out_slop`]) is removed by the soft constraint's bias velocity,
-//! which the relax pass then takes back out; deeper overlap, and the overlap of bodies that
-//! start overlapping or hit fast, is pushed out by split impulses, pseudo velocities that move
-//! the bodies within the substep and are then discarded ([`solve::solve`],
-//! [`integrate::integrate_positions`]). So resolving overlap neither makes things bounce nor
-//! adds kinetic energy. The contacts are solved simultaneously (in a fixed
+//! [`SoftStepSettings::push_out_slop`] and one substep of gravity) is removed by the soft
+//! constraint's bias velocity, which the relax pass then takes back out; deeper overlap, and
+//! the overlap of bodies that start overlapping or hit fast, is pushed out by split impulses,
+//! pseudo velocities that move the bodies within the substep and are then discarded
+//! ([`solve::solve`], [`integrate::integrate_positions`]). So resolving overlap neither makes
+//! things bounce nor adds kinetic energy. The contacts are solved simultaneously (in a fixed
 //! order, colour by colour, to convergence over the substeps), so a Newton's cradle of
 //! touching balls does not give the textbook one-ball-out answer; momentum and energy are
 //! still conserved.

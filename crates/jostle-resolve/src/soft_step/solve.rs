@@ -140,6 +140,13 @@ fn scatter_velocities<F: Lane>(states: &mut [BodyState], idx: [u32; LANES], v: &
     v.store(idx, states, BodyState::velocity_row_mut);
 }
 
+/// Whether any of the eight bodies moves with pseudo velocities in this substep (its
+/// [`PseudoRow`] is marked in lane 3 by [`scatter_pseudo`]).
+#[inline(always)]
+fn any_pseudo(pseudo: &[PseudoRow], idx: [u32; LANES]) -> bool {
+    idx.iter().any(|&i| pseudo[i as usize][3] != 0.0)
+}
+
 /// The pseudo velocities of eight bodies, by lane: rows of [`PseudoRow`] (see
 /// [`solve`]).
 #[inline(always)]
@@ -147,9 +154,15 @@ fn gather_pseudo<F: Lane>(pseudo: &[PseudoRow], idx: [u32; LANES]) -> Velocities
     Velocities::from_columns(F::load_transposed(rows_of(idx, |i| &pseudo[i as usize])))
 }
 
+/// Stores the pseudo velocities of eight bodies and marks their rows (lane 3) as moving.
 #[inline(always)]
 fn scatter_pseudo<F: Lane>(pseudo: &mut [PseudoRow], idx: [u32; LANES], v: &Velocities<F>) {
     v.store(idx, pseudo, |row| row);
+    for &i in &idx {
+        if i != STATIC_BODY {
+            pseudo[i as usize][3] = 1.0;
+        }
+    }
 }
 
 /// A batch's two sides during a kernel: velocities loaded, written back by [`Pair::store`].
@@ -375,6 +388,17 @@ fn project_to_disk<F: Lane>(inv_k: [F; 3], target: [F; 2], r: F, over: F::Mask) 
     ]
 }
 
+/// Adds `delta` to the point's accumulated normal impulse, clamped so that the total never
+/// pulls (≥ 0), and applies the change that remains to the pair.
+#[inline(always)]
+fn accumulate_normal<F: Lane>(pair: &mut Pair<F>, p: &mut PointLanes<F>, delta: F) {
+    let total = (p.normal_impulse + delta).max(F::ZERO);
+    let delta = total - p.normal_impulse;
+    p.normal_impulse = total;
+    p.max_normal_impulse = p.max_normal_impulse.max(delta);
+    pair.apply_normal(p, delta);
+}
+
 /// The relax pass over one batch: every point's normal row rigid and unbiased (a
 /// speculative point keeps its gap rule), then its friction.
 #[inline(always)]
@@ -391,11 +415,7 @@ fn relax_batch<F: Lane>(
         let s = separation(p, &motion_a, &motion_b);
         let bias = F::select(s.cmpgt(F::ZERO), s * inv_h, F::ZERO);
         let vn = pair.relative_velocity(p).dot(p.normal);
-        let total = (p.normal_impulse - p.normal_mass * (vn + bias)).max(F::ZERO);
-        let delta = total - p.normal_impulse;
-        p.normal_impulse = total;
-        p.max_normal_impulse = p.max_normal_impulse.max(delta);
-        pair.apply_normal(p, delta);
+        accumulate_normal(pair, p, -p.normal_mass * (vn + bias));
         if m.friction {
             solve_friction(pair, p);
         }
@@ -450,6 +470,7 @@ fn solve_batch_split<F: Lane>(
     m: &ManifoldLanes<F>,
     pair: &mut Pair<F>,
     pseudo: &mut (Velocities<F>, Velocities<F>),
+    live: &mut bool,
     points: &mut [PointLanes<F>],
     states: &[BodyState],
     pass: BiasedPass,
@@ -483,22 +504,23 @@ fn solve_batch_split<F: Lane>(
 
         let rigid = -p.normal_mass * (vn + s * inv_h);
         let soft = -soft_mass * vn - carried - bleed;
-        let delta = F::select(speculative, rigid, soft);
-        let total = (p.normal_impulse + delta).max(F::ZERO);
-        let delta = total - p.normal_impulse;
-        p.normal_impulse = total;
-        p.max_normal_impulse = p.max_normal_impulse.max(delta);
-        pair.apply_normal(p, delta);
+        accumulate_normal(pair, p, F::select(speculative, rigid, soft));
 
-        let (pa, pb) = (&pseudo.0, &pseudo.1);
-        let vpn = ((pa.linear + pa.angular.cross(p.r_a)) - (pb.linear + pb.angular.cross(p.r_b)))
+        // Pseudo velocities can only change where some lane has excess overlap or the
+        // bodies already move with pseudo velocities (`live`); elsewhere push would be 0.
+        if *live || excess.cmplt(F::ZERO).any() {
+            let (pa, pb) = (&pseudo.0, &pseudo.1);
+            let vpn = ((pa.linear + pa.angular.cross(p.r_a))
+                - (pb.linear + pb.angular.cross(p.r_b)))
             .dot(p.normal);
-        let push = (-soft_mass * vpn - excess).max(F::ZERO);
-        let impulse = p.normal * push;
-        pseudo.0.linear += impulse * pair.inv_mass_a;
-        pseudo.0.angular += p.ang_a_normal * push;
-        pseudo.1.linear -= impulse * pair.inv_mass_b;
-        pseudo.1.angular -= p.ang_b_normal * push;
+            let push = (-soft_mass * vpn - excess).max(F::ZERO);
+            let impulse = p.normal * push;
+            pseudo.0.linear += impulse * pair.inv_mass_a;
+            pseudo.0.angular += p.ang_a_normal * push;
+            pseudo.1.linear -= impulse * pair.inv_mass_b;
+            pseudo.1.angular -= p.ang_b_normal * push;
+            *live = true;
+        }
 
         if m.friction && friction {
             solve_friction(pair, p);
@@ -514,24 +536,31 @@ fn solve_impl<F: Lane>(
     pseudo: &mut [PseudoRow],
     pass: BiasedPass,
 ) {
-    for m in manifolds.iter() {
-        let mut pair = Pair::load(m, states);
-        let mut split = (gather_pseudo(pseudo, m.a), gather_pseudo(pseudo, m.b));
-        let range = m.first as usize..(m.first + m.count) as usize;
-        solve_batch_split(m, &mut pair, &mut split, &mut points[range], states, pass);
-        pair.store(m, states);
-        scatter_pseudo(pseudo, m.a, &split.0);
-        scatter_pseudo(pseudo, m.b, &split.1);
-    }
+    // A batch loads and stores pseudo velocities only when one of its bodies already moves
+    // with them or one of its points pushes: a settled scene's bodies never do (loading and
+    // storing them for every batch costs the 20-row pyramid's resolve stage 13%).
+    for_each_batch!(manifolds, points, states, |m, pair, points, states| {
+        let mut live = any_pseudo(pseudo, m.a) || any_pseudo(pseudo, m.b);
+        let mut split = if live {
+            (gather_pseudo(pseudo, m.a), gather_pseudo(pseudo, m.b))
+        } else {
+            let zero = Velocities::from_columns([F::ZERO; 8]);
+            (zero, zero)
+        };
+        solve_batch_split(m, pair, &mut split, &mut live, points, states, pass);
+        if live {
+            scatter_pseudo(pseudo, m.a, &split.0);
+            scatter_pseudo(pseudo, m.b, &split.1);
+        }
+    });
 }
 
 wide_kernel! {
     /// One biased pass with split impulses ([`solve_batch_split`]): every contact with its
     /// own softness, the push-out of overlap beyond the load's (and beyond the allowance of
-    /// resting contacts; at most `max_push_out`, m/s) in the pseudo
-    /// velocities `pseudo` (one [`PseudoRow`] per body, zero at the start of the pass), with
-    /// friction when `friction` is set (see [`super::SoftStepSettings::friction_in_bias_pass`]).
-    /// `inv_h` is 1/substep (1/s).
+    /// resting contacts; at most `max_push_out`, m/s) in the pseudo velocities `pseudo` (one
+    /// [`PseudoRow`] per body, zero at the start of the pass), with friction when
+    /// [`BiasedPass::friction`] is set.
     pub fn solve(batches: &mut Batches, states: &mut [BodyState], pseudo: &mut [PseudoRow], pass: BiasedPass) -> () = solve_impl;
 }
 
@@ -706,7 +735,7 @@ mod tests {
         const PASS: BiasedPass = BiasedPass {
             inv_h: 4.0 / DT,
             max_push_out: 3.0,
-            slop: 0.02,
+            slop: 0.005,
             resting_speed: 1.0,
             gravity_speed: 9.81 / 240.0,
             friction: false,
@@ -729,6 +758,8 @@ mod tests {
             PASS,
         );
         relax_impl::<F8>(manifolds, points, &mut narrow_states, inv_h);
+        // The pile starts overlapping, so the split push-out did work too.
+        assert!(narrow_pseudo.iter().flatten().any(|&x| x != 0.0));
         let mut narrow = bits(&narrow_states, &narrow_batches);
         narrow.extend(narrow_pseudo.iter().flatten().map(|x| x.to_bits()));
         // The passes did real work.
