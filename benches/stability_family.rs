@@ -4,11 +4,11 @@
 //! engines from the same body descriptions (positions, rotations, half extents, densities,
 //! frictions; jostle's ground half-space is a fixed 4,000 m cuboid in rapier3d with its top
 //! face at y = 0; friction combines as the mean in rapier3d and both sides carry the case's
-//! value). Sleeping is off in both. jostle runs its soft-step resolver at its defaults (the
-//! engine's default resolver, Millington, lets even a 10-box column fall). Each run is 20 s at 60 Hz; the table prints the lateral
-//! drift between 2 s and 20 s, the sink per contact layer, the largest penetration after 2 s,
-//! the bodies that moved more than half a box sideways, and the median ms per step, for both
-//! engines.
+//! value). Sleeping is off in both. jostle runs its default resolver, the soft step, at its
+//! defaults (Millington lets even a 10-box column fall). Each run is 20 s at 60 Hz; the table
+//! prints the lateral drift between 2 s and 20 s, the sink per contact layer, the largest
+//! penetration after 2 s, the bodies that moved more than half a box sideways, and the median
+//! ms per step, for both engines.
 //!
 //! Run: `cargo bench --bench stability_family` (several minutes; `FAMILY=base` runs only the
 //! base family, `FAMILY=variations` only the variations). With `--test` (`cargo test

@@ -121,11 +121,15 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
 
     #[test]
-    fn random_scenes_stay_finite_and_never_gain_kinetic_energy(
+    fn millington_random_scenes_stay_finite_and_never_gain_kinetic_energy(
         bodies in proptest::collection::vec(body(), 1..8),
         floor in any::<bool>(),
     ) {
-        check(bodies, floor, jostle::ResolverChoice::default())?;
+        check(
+            bodies,
+            floor,
+            jostle::ResolverChoice::Millington(Default::default()),
+        )?;
     }
 
     /// Whatever the energy, the soft-step resolver stays finite and never quarantines.

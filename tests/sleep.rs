@@ -1,17 +1,27 @@
 //! Sleep and islands through the world: resting bodies sleep, sleeping poses never change,
-//! wake-ups wake exactly the island touched, forces wake, `can_sleep: false` is honoured.
+//! wake-ups wake exactly the island touched, forces wake, `can_sleep: false` is honoured;
+//! with each resolver wherever bodies touch.
 
 mod common;
 use common::*;
 use jostle::scene::Scene;
-use jostle::{BodyDesc, ShapeDesc, Vec3};
+use jostle::{BodyDesc, ResolverChoice, ShapeDesc, Vec3};
 
 const DT: f32 = 1.0 / 60.0;
 
 #[test]
 fn a_dropped_box_comes_to_rest_and_sleeps_and_then_never_moves() {
+    for r in resolvers() {
+        a_dropped_box_sleeps(&r);
+    }
+}
+
+fn a_dropped_box_sleeps(resolver: &ResolverChoice) {
     let scene = Scene::load(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/box_drop.ron")).unwrap();
-    let mut w = scene.build().unwrap();
+    let mut settings = scene.settings();
+    settings.resolver = resolver.clone();
+    let mut w = scene.build_with(settings).unwrap();
+    let name = resolver.name();
     let h = w.find_body("box").unwrap();
     let mut slept_at = None;
     for step in 1..=400 {
@@ -22,7 +32,7 @@ fn a_dropped_box_comes_to_rest_and_sleeps_and_then_never_moves() {
         }
     }
     let step = slept_at.expect("the box must sleep within 400 steps at 60 Hz");
-    eprintln!("box_drop.ron: the box sleeps after step {step}");
+    eprintln!("box_drop.ron, {name}: the box sleeps after step {step}");
     let pose = (w.body(h).unwrap().position, w.body(h).unwrap().orientation);
     for _ in 0..300 {
         w.step(DT).unwrap();
@@ -60,7 +70,13 @@ fn a_woken_motionless_body_sleeps_again_after_the_bias_decays_its_motion() {
 
 #[test]
 fn a_ball_thrown_into_a_sleeping_pile_wakes_that_island_only() {
-    let mut w = world(Vec3::new(0.0, -9.81, 0.0));
+    for r in resolvers() {
+        a_ball_thrown_into_a_sleeping_pile_wakes_that_island_only_with(&r);
+    }
+}
+
+fn a_ball_thrown_into_a_sleeping_pile_wakes_that_island_only_with(resolver: &ResolverChoice) {
+    let mut w = world_with(Vec3::new(0.0, -9.81, 0.0), resolver);
     ground(&mut w, 0.6, 0.0);
     let pile = |w: &mut jostle::World, x: f32, tag: &str| -> Vec<jostle::BodyHandle> {
         (0..3)
@@ -111,7 +127,13 @@ fn a_ball_thrown_into_a_sleeping_pile_wakes_that_island_only() {
 
 #[test]
 fn a_force_wakes_a_sleeping_body() {
-    let mut w = world(Vec3::new(0.0, -9.81, 0.0));
+    for r in resolvers() {
+        a_force_wakes_a_sleeping_body_with(&r);
+    }
+}
+
+fn a_force_wakes_a_sleeping_body_with(resolver: &ResolverChoice) {
+    let mut w = world_with(Vec3::new(0.0, -9.81, 0.0), resolver);
     ground(&mut w, 0.6, 0.0);
     let h = w
         .add_body(
@@ -138,7 +160,13 @@ fn a_force_wakes_a_sleeping_body() {
 
 #[test]
 fn can_sleep_false_is_honoured() {
-    let mut w = world(Vec3::new(0.0, -9.81, 0.0));
+    for r in resolvers() {
+        can_sleep_false_is_honoured_with(&r);
+    }
+}
+
+fn can_sleep_false_is_honoured_with(resolver: &ResolverChoice) {
+    let mut w = world_with(Vec3::new(0.0, -9.81, 0.0), resolver);
     ground(&mut w, 0.6, 0.0);
     let mut d = BodyDesc::dynamic(
         "insomniac",

@@ -6,11 +6,11 @@
 //! `family_table` prints every case's figures with the soft-step resolver at its defaults, or
 //! with the resolver named by `FAMILY_RESOLVER` (`millington`, `soft-step`): `cargo test
 //! --release --test stability_family -- --ignored --nocapture family_table`; the same scenes
-//! run side by side with rapier3d in `cargo bench --bench stability_family`. The engine's
-//! default resolver (Millington) meets the criterion on none of the family (a 10-box column
-//! falls), so the cases below run the soft step at its defaults: those that meet the criterion
-//! are tests of their own, the others are listed with their figures in benches/RESULTS.md
-//! ("The stability family") until a resolver meets them.
+//! run side by side with rapier3d in `cargo bench --bench stability_family`. The Millington
+//! resolver meets the criterion on none of the family (a 10-box column falls); the cases below
+//! run the engine's default, the soft step at its defaults: those that meet the criterion are
+//! tests of their own, the others are listed with their figures in benches/RESULTS.md ("The
+//! stability family") until a resolver meets them.
 
 mod common;
 
