@@ -7,6 +7,7 @@ use jostle_body::{BodySet, CcdMode, apply_forces};
 use jostle_collide::{
     BodyContact, BroadPhase, CcdSettings, CcdShape, ColliderHandle, ColliderSet, NarrowPhase, Pose,
 };
+use jostle_math::Vec3;
 use jostle_resolve::{Contact, STATIC_BODY, SolverBody};
 use jostle_sleep::{IslandSet, SleepSettings, update_motion};
 
@@ -130,7 +131,7 @@ pub(crate) fn gather(
 /// pose the resolver left in `scratch.bodies`) exceeds `settings.motion_fraction` of its
 /// thickness, or whose mode is `On`, is swept against resting geometry ([`jostle_collide::sweep`]);
 /// on a hit it is moved back along its motion to the time of impact, velocities kept (the
-/// angular one in the body's frame), so the
+/// angular one in the body's frame) less the acceleration of the dropped part of the step, so the
 /// next step's contact resolves the impact (the seed lecture's "move them back to the point
 /// of first collision"). A slow body costs one motion test: a few multiplies and two square
 /// roots. `shapes` is indexed by collider slot.
@@ -202,7 +203,14 @@ pub(crate) fn ccd(
             continue;
         };
         let end = &mut scratch.bodies[solver as usize];
+        let end_position = end.position;
         end.position = start.position.lerp(end.position, t);
+        end.linear_velocity = rewound_velocity(
+            end.linear_velocity,
+            end.last_acceleration,
+            end.position - end_position,
+            (1.0 - t) * dt,
+        );
         // Turned back with the body, the angular velocity keeps its body-frame value, so the
         // rotational energy ½ωᵀIω is unchanged; kept in world frame it would meet a different
         // world inertia and change the energy (found by tests/properties.rs).
@@ -210,6 +218,50 @@ pub(crate) fn ccd(
         end.angular_velocity = (orientation * end.orientation.inverse()) * end.angular_velocity;
         end.orientation = orientation;
     }
+}
+
+/// The velocity of a body moved back by `moved` (m) to a time `dropped` seconds before the end
+/// of the step, from its end-of-step velocity `v` under the acceleration `a` it was integrated
+/// with: v − a·λ with λ = `dropped` (the velocity at that time, for a body in free flight),
+/// unless that would raise its mechanical energy ½v² − a·x, in which case λ is the value
+/// nearest to `dropped` that keeps it (it may be negative: a body put back higher still rising
+/// pays for the height with the part of its speed along a, never with the rest).
+///
+/// Why: kept at `v`, a body stopped early carried a whole step of gravity's speed for part of
+/// the fall that pays for it (m·g·|v|·dt·(1 − t) of energy per stop: a restitution-1 box's
+/// bounces rose, and a body stopped step after step piled speed up in the air); interpolated
+/// back to the step's start instead, the contacts' work was undone too, and a plate the
+/// resolver had already stopped on a floor was sent down again and stopped again, every step;
+/// and a body that bounced at the end of the step, put back higher, gained the height
+/// (benches/RESULTS.md, "Restitution 1 never raises a bounce").
+fn rewound_velocity(v: Vec3, a: Vec3, moved: Vec3, dropped: f32) -> Vec3 {
+    let aa = a.length_squared();
+    if aa.is_nan() || aa <= 0.0 {
+        return v;
+    }
+    // Energy change per unit mass against the end: f(λ) = ½|a|²λ² − (a·v)λ + lift.
+    let lift = -a.dot(moved);
+    let av = a.dot(v);
+    let change = |l: f32| 0.5 * aa * l * l - av * l + lift;
+    let free_flight = change(dropped);
+    if free_flight.is_nan() || free_flight <= 0.0 {
+        return v - a * dropped;
+    }
+    let discriminant = av * av - 2.0 * aa * lift;
+    if discriminant >= 0.0 {
+        // f ≤ 0 between its roots: the λ there nearest to `dropped`.
+        let (low, high) = (
+            (av - discriminant.sqrt()) / aa,
+            (av + discriminant.sqrt()) / aa,
+        );
+        return v - a * dropped.clamp(low, high);
+    }
+    // Not even all of its speed along a pays for the height: that part goes, and the rest
+    // of the speed is lowered to what is left.
+    let along = a * (av / aa);
+    let rest = v - along;
+    let budget = rest.length_squared() - 2.0 * change(av / aa);
+    rest * (budget.max(0.0) / rest.length_squared().max(f32::MIN_POSITIVE)).sqrt()
 }
 
 /// Copies poses and velocities back into the bodies, the contacts' impulses back into the

@@ -32,6 +32,19 @@
 //!   contact's impulse accumulated over the step ([`velocity::coulomb_accumulated`]) and a
 //!   contact whose friction can still act is also picked for its sliding speed
 //!   ([`velocity::velocity_key`]). μ = 0 contacts keep the frictionless path.
+//! - **restitution that gained energy** (tests in `tests/restitution.rs` and `tests/physics.rs`):
+//!   the lecture recomputes a contact's desired change from its velocity after every pick, so
+//!   the closing speed one point's pick drives into its neighbour was bounced too (the
+//!   lecture's own cube edge, as two points, ended at v_y 0.5821 with a spin about x instead
+//!   of 0.6234), and a box landing on an edge gained energy at every impact. Here a contact's
+//!   target velocity is decided once and kept while picks of the same two bodies change its
+//!   velocity, and a pick may take back part of what the contact pushed (accumulated
+//!   clamping), so the points of one impact are resolved together; a pick of another pair
+//!   decides it again, so an impact still travels through touching bodies pair by pair
+//!   (Newton's cradle) ([`PreparedContact::target_velocity`], [`velocity::normal_key`]). And a
+//!   contact found overlapping bounces at the speed its surfaces met at, not the faster one it
+//!   has after overlapping, because the position pass then puts it back where they met
+//!   ([`impact_speed_gain`]).
 //!
 //! The worst contact is found with an indexed max-heap and a body → contacts adjacency
 //! ([`PickStrategy::Heap`], O(degree · log n) per pick) or by Cyclone's rescan
@@ -59,7 +72,7 @@ pub use position::{
     PenetrationMoves, apply_moves, linear_moves, nonlinear_moves, resolve_penetration,
     update_penetration,
 };
-pub use prepare::{PreparedContact, desired_delta_velocity, prepare};
+pub use prepare::{PreparedContact, desired_delta_velocity, impact_speed_gain, prepare};
 pub use priority_queue::IndexedMaxHeap;
 pub use settings::{IterationBudget, MillingtonSettings, PickStrategy, Projection};
 pub use velocity::{
@@ -188,10 +201,12 @@ impl MillingtonResolver {
             p.desired_delta_velocity = desired_delta_velocity(
                 p.velocity.x,
                 p.acc_velocity,
+                p.impact_speed_gain,
                 p.restitution,
                 settings.velocity_limit,
                 p.gap_velocity,
             );
+            p.target_velocity = p.velocity.x + p.desired_delta_velocity;
         }
         let mut pass = VelocityPass {
             contacts: &mut self.prepared,

@@ -23,8 +23,27 @@ pub struct PreparedContact {
     /// Velocity along the normal produced by the last step's acceleration (m/s), the lecture's
     /// v_acc: ((a_A − a_B) · dt) · n.
     pub acc_velocity: f32,
-    /// Normal velocity change the velocity pass aims for (m/s); see [`desired_delta_velocity`].
+    /// Closing speed (m/s, ≥ 0) the contact gained after its surfaces met: a contact found
+    /// overlapping by d, closing at v_r at the start of the step under a closing acceleration
+    /// a_n, has been accelerating for d/|v_r| and met at |v_r| − |a_n|·d/|v_r|. The bounce is
+    /// that speed's, since the position pass puts the bodies back where they met; bounced at
+    /// |v_r| from there, a restitution-1 box rose m·g·d higher at every bounce (benches/
+    /// RESULTS.md, "Restitution 1 never raises a bounce"). See [`impact_speed_gain`].
+    pub impact_speed_gain: f32,
+    /// Normal velocity change the velocity pass aims for (m/s): `target_velocity` − the
+    /// current normal velocity; see [`desired_delta_velocity`].
     pub desired_delta_velocity: f32,
+    /// The normal velocity (m/s) the velocity pass aims for, decided from the closing velocity
+    /// after the position pass ([`desired_delta_velocity`] added to it). Picks of contacts
+    /// between the same two bodies leave it as it is, so the points of one impact are
+    /// resolved together and a pick may take back part of what the contact pushed
+    /// (accumulated clamping); recomputed after each of them, as the lecture does, the rule
+    /// bounced what a neighbouring point's pick had driven into the surface, and a box landing
+    /// on an edge gained energy at every impact (benches/RESULTS.md, "Restitution 1 never
+    /// raises a bounce"). A pick of another pair is a new collision for the contact: its target
+    /// is decided again from the velocity that pick left ([`super::velocity::update_velocity`]),
+    /// so an impact passed on through touching bodies (Newton's cradle) travels pair by pair.
+    pub target_velocity: f32,
     /// For a speculative contact (negative penetration: a gap), the closing speed the gap
     /// absorbs within the step, gap/dt (m/s); zero for touching or overlapping contacts. Set
     /// after the position pass, which may change the gap.
@@ -98,7 +117,9 @@ impl PreparedContact {
             r: [Vec3::ZERO; 2],
             velocity: Vec3::ZERO,
             acc_velocity: 0.0,
+            impact_speed_gain: 0.0,
             desired_delta_velocity: 0.0,
+            target_velocity: 0.0,
             gap_velocity: 0.0,
             penetration,
             friction: 0.0,
@@ -121,7 +142,9 @@ impl PreparedContact {
 
 /// The desired normal velocity change of the micro-collision rule (seed lecture, "Remove
 /// Accelerated Velocity" and "Lower the Restitution"):
-/// Δv = −v − e′·(v − v_acc), with e′ = 0 when |v| < `velocity_limit`, else `restitution`.
+/// Δv = −v − e′·(v − v_acc + g), with e′ = 0 when |v| < `velocity_limit`, else `restitution`,
+/// and g the closing speed gained since the surfaces met ([`impact_speed_gain`]; the bounced
+/// term is never allowed to turn into a separating one).
 ///
 /// `v` is the normal closing velocity (negative when approaching). The lecture's slide tests
 /// `contactVelocity.magnitude()`; the limit is about the bounce, so jostle (like Cyclone's
@@ -130,6 +153,7 @@ impl PreparedContact {
 pub fn desired_delta_velocity(
     v: f32,
     acc_velocity: f32,
+    impact_speed_gain: f32,
     restitution: f32,
     velocity_limit: f32,
     gap_velocity: f32,
@@ -149,8 +173,32 @@ pub fn desired_delta_velocity(
     if e == 0.0 {
         -(v + gap_velocity)
     } else {
-        -v - e * (v - acc_velocity)
+        -v - e * (v - acc_velocity + impact_speed_gain).min(0.0)
     }
+}
+
+/// The closing speed (m/s, ≥ 0) a contact overlapping by `penetration` gained after its
+/// surfaces met: with v_r the closing velocity at the start of the step (negative when
+/// approaching) and a_n = `acc_velocity`/`dt` the normal relative acceleration, the surfaces
+/// met d/|v_r| ago, at a speed a_n·d/v_r lower. Zero unless the contact overlaps, approaches
+/// and is accelerated into itself: the correction only ever lowers a bounce.
+///
+/// To first order this is exactly the potential energy the position pass adds by moving the
+/// bodies back out: a point with effective inverse mass K bounced at a speed lower by
+/// δ = |a_n|·d/|v_r| loses |v_r|·δ/K of kinetic energy, and lifting it by d raises its centre
+/// of mass by d/(m·K), which costs m·|a_n|·d/(m·K): the same.
+#[inline]
+pub fn impact_speed_gain(
+    closing_velocity: f32,
+    acc_velocity: f32,
+    penetration: f32,
+    dt: f32,
+) -> f32 {
+    if !(penetration > 0.0 && closing_velocity < 0.0 && acc_velocity < 0.0 && dt > 0.0) {
+        return 0.0;
+    }
+    let gain = (acc_velocity / dt) * penetration / closing_velocity;
+    if gain.is_finite() { gain } else { 0.0 }
 }
 
 /// Whether side body `index` of a contact moves in the passes.
@@ -234,18 +282,24 @@ pub fn prepare(
         }
     }
 
+    // The closing velocity at the start of the step, where the contact was detected.
+    let gain = impact_speed_gain(velocity.x - acc.x, acc.x, contact.penetration, dt);
+    let desired = desired_delta_velocity(
+        velocity.x,
+        acc.x,
+        gain,
+        contact.restitution,
+        velocity_limit,
+        0.0,
+    );
     Some(PreparedContact {
         basis,
         r,
         velocity,
         acc_velocity: acc.x,
-        desired_delta_velocity: desired_delta_velocity(
-            velocity.x,
-            acc.x,
-            contact.restitution,
-            velocity_limit,
-            0.0,
-        ),
+        impact_speed_gain: gain,
+        desired_delta_velocity: desired,
+        target_velocity: velocity.x + desired,
         gap_velocity: 0.0,
         penetration: contact.penetration,
         friction: contact.friction,
@@ -267,16 +321,41 @@ mod tests {
     #[test]
     fn restitution_is_dropped_below_the_velocity_limit() {
         // Slow: e′ = 0, the contact is only stopped.
-        assert_eq!(desired_delta_velocity(-0.2, 0.0, 0.8, 0.25, 0.0), 0.2);
+        assert_eq!(desired_delta_velocity(-0.2, 0.0, 0.0, 0.8, 0.25, 0.0), 0.2);
         // Fast: full bounce.
-        assert!((desired_delta_velocity(-1.0, 0.0, 0.5, 0.25, 0.0) - 1.5).abs() < 1e-6);
+        assert!((desired_delta_velocity(-1.0, 0.0, 0.0, 0.5, 0.25, 0.0) - 1.5).abs() < 1e-6);
         // The acceleration of the last step is not bounced back.
-        assert!((desired_delta_velocity(-1.0, -0.5, 0.5, 0.25, 0.0) - 1.25).abs() < 1e-6);
+        assert!((desired_delta_velocity(-1.0, -0.5, 0.0, 0.5, 0.25, 0.0) - 1.25).abs() < 1e-6);
         // A 1 cm gap at 60 Hz absorbs 0.6 m/s: a slower approach is left alone, a faster one
         // is stopped exactly at the surface (inelastic) or bounced (elastic).
-        assert!(desired_delta_velocity(-0.5, 0.0, 0.0, 0.25, 0.6) < 0.0);
-        assert!((desired_delta_velocity(-1.0, 0.0, 0.0, 0.25, 0.6) - 0.4).abs() < 1e-6);
-        assert!((desired_delta_velocity(-1.0, 0.0, 0.5, 0.25, 0.6) - 1.5).abs() < 1e-6);
+        assert!(desired_delta_velocity(-0.5, 0.0, 0.0, 0.0, 0.25, 0.6) < 0.0);
+        assert!((desired_delta_velocity(-1.0, 0.0, 0.0, 0.0, 0.25, 0.6) - 0.4).abs() < 1e-6);
+        assert!((desired_delta_velocity(-1.0, 0.0, 0.0, 0.5, 0.25, 0.6) - 1.5).abs() < 1e-6);
+    }
+
+    /// A box found 57 mm into the floor, closing at 6.703 m/s at the start of a 60 Hz step
+    /// (v_acc = −9.81/60): its surfaces met 8.5 ms earlier, at 0.083 m/s less. By energy the
+    /// speed there is √(6.703² − 2·9.81·0.057) = 6.6193; the first-order rule gives 6.6196.
+    #[test]
+    fn the_bounce_is_the_speed_the_surfaces_met_at() {
+        let (v, acc, d, dt) = (-6.703f32, -9.81 / 60.0, 0.057, 1.0 / 60.0);
+        let gain = impact_speed_gain(v, acc, d, dt);
+        assert!((gain - 9.81 * d / 6.703).abs() < 1e-5, "gain {gain}");
+        let met = (v * v - 2.0 * 9.81 * d).sqrt();
+        assert!(
+            ((-v - gain) - met).abs() < 1e-3,
+            "{} against {met}",
+            -v - gain
+        );
+        // With e = 1 the bounce is that speed, away from the surface (the velocity the pass
+        // sees includes this step's v_acc, which is not bounced).
+        let now = v + acc;
+        let target = now + desired_delta_velocity(now, acc, gain, 1.0, 0.25, 0.0);
+        assert!((target - (-v - gain)).abs() < 1e-4, "target {target}");
+        // Nothing for a contact that is not overlapping, separating, or not accelerated in.
+        assert_eq!(impact_speed_gain(v, acc, -0.01, dt), 0.0);
+        assert_eq!(impact_speed_gain(1.0, acc, d, dt), 0.0);
+        assert_eq!(impact_speed_gain(v, 0.1, d, dt), 0.0);
     }
 
     #[test]

@@ -59,16 +59,19 @@ pub fn impulse_matrix(p: &PreparedContact, bodies: &[SolverBody]) -> Mat3 {
     k
 }
 
-/// The frictionless impulse (contact space): (Δv / Δq̇_t, 0, 0), clamped to a push. Zero when
-/// the contact cannot be resolved (total inertia zero) or would need to pull.
+/// The frictionless impulse (contact space): (Δv / Δq̇_t, 0, 0), with the contact's total
+/// impulse of the step clamped to a push. Zero when the contact cannot be resolved (total
+/// inertia zero).
 pub fn frictionless_impulse(p: &PreparedContact) -> Vec3 {
     let k00 = p.normal_inertia;
     if !(k00 > 0.0) {
         // Fix: Cyclone divides by zero here when both bodies are immovable.
         return Vec3::ZERO;
     }
-    let g = p.desired_delta_velocity / k00;
-    if g > 0.0 {
+    // Clamped on the step's accumulated impulse: a pick may take back part of its earlier
+    // pushes (never pull).
+    let g = (p.impulse.x + p.desired_delta_velocity / k00).max(0.0) - p.impulse.x;
+    if g.is_finite() {
         Vec3::new(g, 0.0, 0.0)
     } else {
         Vec3::ZERO
@@ -124,7 +127,9 @@ pub fn friction_pick(p: &PreparedContact, bodies: &[SolverBody]) -> FrictionPick
         // No normal impulse this step and none wanted: no friction to give.
         return no_friction(Vec3::ZERO);
     }
-    let desired = if p.desired_delta_velocity < 0.0 {
+    // Past its target (Δv < 0) a contact gives back part of what it pushed this step, never
+    // more; with nothing pushed, its normal velocity is left as it is.
+    let desired = if p.desired_delta_velocity < 0.0 && !(p.impulse.x > 0.0) {
         0.0
     } else {
         p.desired_delta_velocity
@@ -287,7 +292,7 @@ pub fn velocity_key(p: &PreparedContact) -> f32 {
     if !(p.normal_inertia > 0.0) {
         return f32::NEG_INFINITY;
     }
-    let normal = p.desired_delta_velocity;
+    let normal = normal_key(p);
     if has_friction_capacity(p) {
         let sliding = (p.velocity.y * p.velocity.y + p.velocity.z * p.velocity.z).sqrt();
         if sliding > normal {
@@ -295,6 +300,21 @@ pub fn velocity_key(p: &PreparedContact) -> f32 {
         }
     }
     normal
+}
+
+/// The normal part of [`velocity_key`] (m/s): the desired normal change when it is a push; past
+/// the target (Δv < 0), the part of the overshoot the contact can take back by giving up the
+/// impulse it pushed this step (at most impulse × normal inertia), so a contact that was
+/// pushed past its target by its own earlier pick and its neighbours' is picked again
+/// (Gauss-Seidel with accumulated clamping) instead of keeping a bounce higher than its target.
+#[inline]
+pub fn normal_key(p: &PreparedContact) -> f32 {
+    let desired = p.desired_delta_velocity;
+    if desired >= 0.0 || desired.is_nan() {
+        desired
+    } else {
+        (-desired).min(p.impulse.x.max(0.0) * p.normal_inertia)
+    }
 }
 
 /// The impulse the velocity pass applies at `p` (contact space, on A): frictionless when
@@ -353,7 +373,10 @@ pub fn resolve_velocity(p: &mut PreparedContact, bodies: &mut [SolverBody]) -> B
 }
 
 /// Updates the closing velocity and desired velocity change of `p` after `change` was applied
-/// to bodies it may share: Δv_contact = ±Mᵀ(Δv + Δω × r), + for side A, − for side B.
+/// to bodies it may share: Δv_contact = ±Mᵀ(Δv + Δω × r), + for side A, − for side B. The
+/// desired change is what is left to the contact's target ([`PreparedContact::target_velocity`]);
+/// a change made by a contact between other bodies decides the target again, by the
+/// micro-collision rule from the new velocity (a push only).
 /// Returns whether `p` shared a body with the change.
 pub fn update_velocity(p: &mut PreparedContact, change: &BodyChange, velocity_limit: f32) -> bool {
     let mut touched = false;
@@ -366,13 +389,21 @@ pub fn update_velocity(p: &mut PreparedContact, change: &BodyChange, velocity_li
         touched = true;
     }
     if touched {
-        p.desired_delta_velocity = desired_delta_velocity(
-            p.velocity.x,
-            p.acc_velocity,
-            p.restitution,
-            velocity_limit,
-            p.gap_velocity,
-        );
+        let same_pair = change.body == p.body || change.body == [p.body[1], p.body[0]];
+        if !same_pair {
+            // A new collision, or nothing to do: what the other pair's pick left is kept
+            // unless the micro-collision rule wants a push.
+            let desired = desired_delta_velocity(
+                p.velocity.x,
+                p.acc_velocity,
+                p.impact_speed_gain,
+                p.restitution,
+                velocity_limit,
+                p.gap_velocity,
+            );
+            p.target_velocity = p.velocity.x + desired.max(0.0);
+        }
+        p.desired_delta_velocity = p.target_velocity - p.velocity.x;
     }
     touched
 }

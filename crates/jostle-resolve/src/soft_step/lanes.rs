@@ -60,6 +60,14 @@ impl F8 {
     }
 }
 
+impl M8 {
+    /// Bit `i` set for each set lane `i`.
+    #[inline(always)]
+    pub fn bitmask(self) -> u32 {
+        self.0[0].bitmask() | (self.0[1].bitmask() << 4)
+    }
+}
+
 impl BitAnd for M8 {
     type Output = Self;
     #[inline(always)]

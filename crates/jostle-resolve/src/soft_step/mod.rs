@@ -17,7 +17,12 @@
 //!    (and the pseudo velocities, which are then cleared) into position and rotation deltas;
 //!    relax (solve again without bias). Friction is solved in the relax pass only, unless
 //!    [`SoftStepSettings::friction_in_bias_pass`] is set.
-//! 3. restitution, skipped when no contact has e > 0;
+//! 3. restitution, skipped when no contact bounces: Newton's law at every point that approached
+//!    faster than the threshold, swept to convergence with the rest of the contacts, through
+//!    each body's inertia as it has turned since the start of the step
+//!    ([`solve::restitution_response`]), leaving alone points that were separating at the start
+//!    of the step, and bounded so that a body bouncing only off immovable bodies ends the step
+//!    with no more mechanical energy than it began with (`bound_bounce_energy`);
 //! 4. store the impulses and the remaining penetration in the contacts, the poses and
 //!    velocities in the bodies.
 //!
@@ -129,6 +134,14 @@ pub struct SoftStepResolver {
     saved_impulse: Vec<lanes::F8>,
     /// Each body's pseudo velocities of the current substep ([`PseudoRow`]).
     pseudo: Vec<PseudoRow>,
+    /// Each body's velocities before the restitution pass (linear, angular).
+    before_restitution: Vec<(jostle_math::Vec3, jostle_math::Vec3)>,
+    /// Which bodies bounce in the restitution pass, and against what ([`solve::bounce_marks`]).
+    bounce_marks: Vec<u8>,
+    /// Each body's world inverse inertia after the substeps, for the restitution pass.
+    inv_inertia_now: Vec<Mat3>,
+    /// Each point's response in the restitution pass ([`solve::restitution_response`]).
+    response: Vec<solve::Response>,
 }
 
 impl SoftStepResolver {
@@ -167,6 +180,66 @@ impl SoftStepResolver {
             if let Some(i) = self.inertia.get_mut(STATIC_BODY as usize) {
                 *i = Mat3::ZERO;
             }
+        }
+    }
+
+    /// The energy bound of the restitution pass: a body that bounced this step only off
+    /// bodies that cannot move ends the step with no more mechanical energy than it began
+    /// with, K_end ≤ K_start + m·g·Δx (e ≤ 1 returns at most what the impact took, and the
+    /// substeps' symplectic integration of gravity alone never exceeds this). Where the pass
+    /// gave more, the velocity change it made to that body is scaled back to the largest
+    /// fraction that meets the bound.
+    ///
+    /// Why: the pass reflects each point's approach velocity at the start of the step, at the
+    /// poses the substeps left. A body that turned a large angle within the step (a 0.1 m
+    /// plank at 70 rad/s turns 1.2 rad in a 60 Hz step) meets the floor with other corners, at
+    /// other speeds, than the step-start velocities describe, and reflecting those tripled the
+    /// plank's energy in one bounce (benches/RESULTS.md, "Restitution 1 never raises a bounce").
+    /// Bodies that bounce off other moving bodies are left alone: energy may pass between
+    /// them (a Newton's cradle).
+    fn bound_bounce_energy(&mut self, bodies: &[SolverBody], gravity: jostle_math::Vec3) {
+        for (i, &mark) in self.bounce_marks.iter().enumerate() {
+            if mark != solve::BOUNCES_ON_FIXED {
+                continue;
+            }
+            let (Some(start), Some(state), Some(&(v_s, w_s))) = (
+                bodies.get(i),
+                self.states.get_mut(i),
+                self.before_restitution.get(i),
+            ) else {
+                continue;
+            };
+            if !(start.inv_mass > 0.0) {
+                continue;
+            }
+            let mass = 1.0 / start.inv_mass;
+            let inertia = if start.rotates() {
+                gyroscopic::inertia_of(start.inv_inertia).unwrap_or(Mat3::ZERO)
+            } else {
+                Mat3::ZERO
+            };
+            let inertia_now = gyroscopic::rotate_inertia(inertia, state.delta_rotation);
+            let energy = |v: jostle_math::Vec3, w: jostle_math::Vec3, i: Mat3| {
+                0.5 * mass * v.length_squared() + 0.5 * w.dot(i * w)
+            };
+            let allowed = energy(start.linear_velocity, start.angular_velocity, inertia)
+                + mass * gravity.dot(state.delta_position);
+            let (dv, dw) = (state.linear_velocity - v_s, state.angular_velocity - w_s);
+            // K(s) = k + b·s + a·s² along the pass's change, s ∈ [0, 1].
+            let k = energy(v_s, w_s, inertia_now);
+            let a = energy(dv, dw, inertia_now);
+            let b = mass * v_s.dot(dv) + w_s.dot(inertia_now * dw);
+            if !(k + b + a > allowed) {
+                continue;
+            }
+            let s = if !(k < allowed) || !(a > 0.0) {
+                0.0
+            } else {
+                ((-b + (b * b - 4.0 * a * (k - allowed)).max(0.0).sqrt()) / (2.0 * a))
+                    .clamp(0.0, 1.0)
+            };
+            state.linear_velocity = v_s + dv * s;
+            state.angular_velocity = w_s + dw * s;
         }
     }
 
@@ -277,13 +350,42 @@ impl Resolver for SoftStepResolver {
             self.saved_impulse.clear();
             self.saved_impulse
                 .extend(self.batches.points.iter().map(|p| p.normal_impulse));
+            self.before_restitution.clear();
+            self.before_restitution.extend(
+                self.states
+                    .iter()
+                    .map(|s| (s.linear_velocity, s.angular_velocity)),
+            );
+            solve::bounce_marks(
+                &self.batches,
+                threshold,
+                self.states.len(),
+                &mut self.bounce_marks,
+            );
+            self.inv_inertia_now.clear();
+            self.inv_inertia_now
+                .extend(bodies.iter().zip(&self.states).map(|(b, s)| {
+                    if b.rotates() {
+                        let r = Mat3::from_quat(s.delta_rotation);
+                        r * b.inv_inertia * r.transpose()
+                    } else {
+                        Mat3::ZERO
+                    }
+                }));
+            solve::restitution_response(&self.batches, &self.inv_inertia_now, &mut self.response);
             for _ in 0..self.settings.restitution_iterations {
-                let correction =
-                    solve::restitution(&mut self.batches, &mut self.states, threshold, inv_h);
+                let correction = solve::restitution(
+                    &mut self.batches,
+                    &mut self.states,
+                    &self.response,
+                    threshold,
+                    inv_h,
+                );
                 if !(correction > SoftStepSettings::RESTITUTION_TOLERANCE) {
                     break;
                 }
             }
+            self.bound_bounce_energy(bodies, ctx.gravity);
             for (p, &saved) in self.batches.points.iter_mut().zip(&self.saved_impulse) {
                 p.normal_impulse = saved;
             }

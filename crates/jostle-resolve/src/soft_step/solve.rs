@@ -22,6 +22,7 @@ use super::batch::{Batches, LANES, ManifoldLanes, PointLanes};
 use super::body_state::{BodyState, PseudoRow};
 use super::lanes::{F8, Lane, LaneMask, Q8, V3x8};
 use crate::STATIC_BODY;
+use jostle_math::Mat3;
 
 /// The velocities of eight bodies, by lane.
 #[derive(Clone, Copy)]
@@ -593,6 +594,41 @@ fn bounces(p: &PointLanes, threshold: F8) -> super::lanes::M8 {
         & p.max_normal_impulse.cmpgt(F8::ZERO)
 }
 
+/// [`bounce_marks`]: the body bounces this step off a body that cannot move.
+pub const BOUNCES_ON_FIXED: u8 = 1;
+/// [`bounce_marks`]: the body bounces this step off a body that can move (energy may pass
+/// between them).
+pub const BOUNCES_ON_MOVING: u8 = 2;
+
+/// Marks in `marks` (one per body, cleared and sized to `bodies` here) which bodies take part
+/// in a bounce of the restitution pass, and against what ([`BOUNCES_ON_FIXED`],
+/// [`BOUNCES_ON_MOVING`]).
+pub fn bounce_marks(batches: &Batches, threshold: f32, bodies: usize, marks: &mut Vec<u8>) {
+    marks.clear();
+    marks.resize(bodies, 0);
+    let threshold = F8::splat(threshold);
+    for m in &batches.manifolds {
+        let range = m.first as usize..(m.first + m.count) as usize;
+        let lanes = batches.points[range]
+            .iter()
+            .fold(0, |acc, p| acc | bounces(p, threshold).bitmask());
+        for lane in (0..LANES).filter(|&l| lanes & (1 << l) != 0) {
+            let (a, b) = (m.a[lane] as usize, m.b[lane] as usize);
+            let (moves_a, moves_b) = (m.inv_mass_a[lane] > 0.0, m.inv_mass_b[lane] > 0.0);
+            let mark = if moves_a && moves_b {
+                BOUNCES_ON_MOVING
+            } else {
+                BOUNCES_ON_FIXED
+            };
+            for (body, moves) in [(a, moves_a), (b, moves_b)] {
+                if moves && let Some(slot) = marks.get_mut(body) {
+                    *slot |= mark;
+                }
+            }
+        }
+    }
+}
+
 /// Whether any contact bounces (see [`restitution`]); the pass is skipped otherwise.
 pub fn any_bounces(batches: &Batches, threshold: f32) -> bool {
     let threshold = F8::splat(threshold);
@@ -602,7 +638,8 @@ pub fn any_bounces(batches: &Batches, threshold: f32) -> bool {
 /// One sweep of the restitution pass, after the substeps: every contact that bounces gets
 /// the normal velocity −e·v₀ (v₀ its approach velocity at the start of the step); every
 /// other contact is solved rigidly without bias (normal only), as touching if it pushed
-/// during the step and with the speculative gap rule of [`relax`] if it did not. Accumulated
+/// during the step and with the speculative gap rule of [`relax`] if it did not, except
+/// contacts that were separating at the start of the step, which the pass leaves alone. Accumulated
 /// impulses stay ≥ 0. Returns the largest normal velocity correction of the sweep (m/s),
 /// for the caller's convergence test.
 ///
@@ -612,9 +649,12 @@ pub fn any_bounces(batches: &Batches, threshold: f32) -> bool {
 /// inelastically: the cradle loses 40% of its energy in one step. Sweeping every contact
 /// until the velocities agree gives the simultaneous (LCP) answer with Newton's restitution
 /// law, which conserves the energy of an elastic chain.
+///
+/// `response` is [`restitution_response`] of `batches`.
 pub fn restitution(
     batches: &mut Batches,
     states: &mut [BodyState],
+    response: &[Response],
     threshold: f32,
     inv_h: f32,
 ) -> f32 {
@@ -626,7 +666,11 @@ pub fn restitution(
     } = batches;
     for_each_batch!(manifolds, points, states, |m, pair, points, states| {
         let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
-        for p in points.iter_mut() {
+        let first = m.first as usize;
+        for (p, now) in points
+            .iter_mut()
+            .zip(&response[first..first + m.count as usize])
+        {
             let vn = pair.relative_velocity(p).dot(p.normal);
             let s = separation(p, &motion_a, &motion_b);
             // A contact that pushed during the step is treated as touching even if a gap
@@ -634,26 +678,89 @@ pub fn restitution(
             // (which would turn the rest of an elastic impact into an inelastic one next
             // step). Only contacts that never engaged keep the speculative allowance.
             let free_gap = s.cmpgt(F8::ZERO) & p.max_normal_impulse.cmple(F8::ZERO);
+            let separated = p.relative_velocity.cmpgt(F8::ZERO);
             let resting = F8::select(free_gap, -s * inv_h, F8::ZERO);
             let target = F8::select(
                 bounces(p, threshold),
                 -p.restitution * p.relative_velocity,
                 resting,
             );
-            let delta = -p.normal_mass * (vn - target);
+            let delta = -now.mass * (vn - target);
             let total = (p.normal_impulse + delta).max(F8::ZERO);
+            // A point that was separating at the start of the step is no part of the impact,
+            // even if the body turned onto it within the step and it pushed: its elastic
+            // answer is the reversed motion, which drives it back into the surface, where the
+            // next step bounces it. Held at zero closing speed here instead, it forced the
+            // impact's other points above their bounce: a flat box landing on one edge while
+            // its other edge rose gained 60% of its energy in one step (benches/RESULTS.md,
+            // "Restitution 1 never raises a bounce").
+            let total = F8::select(separated, p.normal_impulse, total);
             let delta = total - p.normal_impulse;
             p.normal_impulse = total;
-            let correction = F8::select(
-                p.normal_mass.cmpgt(F8::ZERO),
-                delta.abs() / p.normal_mass,
-                F8::ZERO,
-            );
+            let correction = F8::select(now.mass.cmpgt(F8::ZERO), delta.abs() / now.mass, F8::ZERO);
             largest = largest.max(correction);
-            pair.apply_normal(p, delta);
+            let impulse = p.normal * delta;
+            pair.a.linear += impulse * pair.inv_mass_a;
+            pair.a.angular += now.ang_a * delta;
+            pair.b.linear -= impulse * pair.inv_mass_b;
+            pair.b.angular -= now.ang_b * delta;
         }
     });
     largest.max_element()
+}
+
+/// A contact point's response to a normal impulse after the substeps, for the restitution
+/// pass: the angular response I⁻¹·(r × n) through each body's world inverse inertia turned with
+/// the body since the start of the step (Δq·I⁻¹·Δqᵀ), and the normal effective mass it gives.
+/// The lever arms stay the step-start ones, as in every other pass (for a ball the contact
+/// point stays under the centre however it rolls).
+///
+/// Why: the pass runs after the substeps, when a fast spinner may have turned a third of a
+/// radian. With the step-start inertia its impulses changed the spin through a tensor the body
+/// no longer has, so a single elastic contact on a spinning plank changed the plank's kinetic
+/// energy (measured with its inertia now) by several per cent (benches/RESULTS.md,
+/// "Restitution 1 never raises a bounce"). Any lever arm with the inertia the energy is
+/// measured with makes an elastic single contact exact.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Response {
+    ang_a: V3x8<F8>,
+    ang_b: V3x8<F8>,
+    /// 1/(n·K·n), zero where K is not positive.
+    mass: F8,
+}
+
+/// Fills `out` with the [`Response`] of every point of `batches`, with `inv_inertia_now` each
+/// body's world inverse inertia at the end of the substeps (zero for bodies that do not turn).
+pub fn restitution_response(batches: &Batches, inv_inertia_now: &[Mat3], out: &mut Vec<Response>) {
+    out.clear();
+    out.resize(batches.points.len(), Response::default());
+    let inertia = |body: u32| {
+        inv_inertia_now
+            .get(body as usize)
+            .copied()
+            .unwrap_or(Mat3::ZERO)
+    };
+    for m in &batches.manifolds {
+        let range = m.first as usize..(m.first + m.count) as usize;
+        for (p, r) in batches.points[range.clone()].iter().zip(&mut out[range]) {
+            let mass: [f32; LANES] = std::array::from_fn(|lane| {
+                let n = p.normal.lane(lane);
+                let rn_a = p.r_a.lane(lane).cross(n);
+                let rn_b = p.r_b.lane(lane).cross(n);
+                let ang_a = inertia(m.a[lane]) * rn_a;
+                let ang_b = inertia(m.b[lane]) * rn_b;
+                r.ang_a.set_lane(lane, ang_a);
+                r.ang_b.set_lane(lane, ang_b);
+                let k = m.inv_mass_a[lane] + m.inv_mass_b[lane] + rn_a.dot(ang_a) + rn_b.dot(ang_b);
+                if k > 0.0 && k.is_finite() {
+                    1.0 / k
+                } else {
+                    0.0
+                }
+            });
+            r.mass = F8::from_array(mass);
+        }
+    }
 }
 
 /// Calls `f` for every contact packed in `batches` with its input index, its accumulated
