@@ -111,8 +111,11 @@ pub fn run(
         kinetic_energy_initial: world.kinetic_energy(),
         ..Default::default()
     };
+    // Reserved for at most 65,536 steps: reserving `steps` up front made `--steps 4000000000`
+    // abort on a 64 GB allocation before the first step. Longer runs grow as they go.
+    let reserve = steps.min(1 << 16) as usize;
     let mut stage_times: Vec<Vec<Duration>> = (0..crate::StepProfile::STAGES)
-        .map(|_| Vec::with_capacity(steps as usize))
+        .map(|_| Vec::with_capacity(reserve))
         .collect();
     let dynamic = world.bodies().filter(|(_, _, b)| !b.is_fixed()).count();
     for step in 1..=steps {

@@ -104,11 +104,6 @@ pub fn start(
             Some(Gif { writer, every })
         }
     };
-    if format == Format::Png {
-        // Fail now, not after the run, if the file cannot be written.
-        File::create(&flags.path)
-            .map_err(|e| format!("{}: cannot create: {e}", flags.path.display()))?;
-    }
     Ok(RenderJob {
         renderer,
         path: flags.path.clone(),

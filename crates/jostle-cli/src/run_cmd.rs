@@ -10,7 +10,7 @@ use jostle::run::{
 };
 use std::fs::File;
 use std::io::{BufWriter, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 /// Arguments of `jostle run`.
@@ -46,7 +46,13 @@ pub struct RunArgs {
     #[arg(long, value_name = "K", requires = "render")]
     frame_every: Option<u64>,
     /// GIF: frames per second of playback (1 to 50).
-    #[arg(long, default_value_t = 30, value_name = "N", requires = "render")]
+    #[arg(
+        long,
+        default_value_t = 30,
+        value_name = "N",
+        requires = "render",
+        value_parser = clap::value_parser!(u32).range(1..=50)
+    )]
     fps: u32,
     /// Image size in pixels.
     #[arg(
@@ -90,7 +96,15 @@ pub fn run(args: RunArgs) -> Result<(), String> {
     }
     let steps = args.steps.unwrap_or(scene_steps);
     let resolver_name = world.resolver_name();
-    let last_step = world.time().1 + steps;
+    let last_step = world.time().1.saturating_add(steps);
+    check_outputs(
+        &args.scene,
+        &[
+            ("--trace", args.trace.as_deref()),
+            ("--render", args.render.as_deref()),
+            ("--snapshot", args.snapshot.as_deref()),
+        ],
+    )?;
 
     let mut render = match &args.render {
         Some(path) => {
@@ -172,6 +186,71 @@ pub fn run(args: RunArgs) -> Result<(), String> {
         print_table(&scene_name, resolver_name, dt, bodies, &summary);
     }
     Ok(())
+}
+
+/// Checks the output files before anything is written, so that a bad one loses nothing: none
+/// may be the scene being read or another output (an output named like the input used to
+/// overwrite the scene with CSV and exit 0), and each must be writable (a trace into a missing
+/// directory used to fail after the PNG had been truncated, and a snapshot was tried only after
+/// the whole run). The check opens an existing file without truncating it and removes a file
+/// it had to create.
+fn check_outputs(scene: &Path, outputs: &[(&str, Option<&Path>)]) -> Result<(), String> {
+    let scene_id = identity(scene);
+    let mut seen: Vec<(&str, PathBuf)> = Vec::new();
+    for &(flag, path) in outputs {
+        let Some(path) = path else { continue };
+        let id = identity(path);
+        if id == scene_id {
+            return Err(format!(
+                "{flag} {}: that is the scene being run; choose another file",
+                path.display()
+            ));
+        }
+        if let Some((other, _)) = seen.iter().find(|(_, p)| *p == id) {
+            return Err(format!(
+                "{flag} {}: {other} writes the same file; choose another",
+                path.display()
+            ));
+        }
+        writable(path).map_err(|e| format!("{flag} {}: cannot write: {e}", path.display()))?;
+        seen.push((flag, id));
+    }
+    Ok(())
+}
+
+/// The path a file is known by: canonical when it exists, else its directory's canonical path
+/// joined with its name (so `./a.csv` and `a.csv` are one file).
+fn identity(path: &Path) -> PathBuf {
+    if let Ok(p) = std::fs::canonicalize(path) {
+        return p;
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    match (std::fs::canonicalize(dir), path.file_name()) {
+        (Ok(d), Some(name)) => d.join(name),
+        _ => path.to_path_buf(),
+    }
+}
+
+/// Whether `path` can be written, without truncating it if it exists.
+fn writable(path: &Path) -> std::io::Result<()> {
+    if path.is_dir() {
+        return Err(std::io::Error::other("it is a directory"));
+    }
+    if path.exists() {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open(path)
+            .map(|_| ())
+    } else {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(path)?;
+        std::fs::remove_file(path)
+    }
 }
 
 fn ms(d: Duration) -> f64 {

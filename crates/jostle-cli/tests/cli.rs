@@ -379,3 +379,83 @@ fn a_snapshot_continues_the_trace_bit_for_bit() {
         whole.iter().filter(|r| step_of(r) <= 150).collect(),
     );
 }
+
+/// An output that is the scene itself, or another output, is refused before anything is
+/// written, and a bad output loses nothing already on disk (issue 16): `--trace scene.ron`
+/// used to overwrite the scene with CSV and exit 0, and `--render keep.png --trace
+/// /nonexistent/t.csv` truncated keep.png to 0 bytes.
+#[test]
+fn outputs_never_overwrite_the_scene_each_other_or_an_untouched_file() {
+    let scene = temp("own.ron");
+    let text = std::fs::read_to_string(asset("box_drop.ron")).unwrap();
+    std::fs::write(&scene, &text).unwrap();
+    let s = scene.to_str().unwrap();
+    let keep = temp("keep.png");
+    std::fs::write(&keep, b"precious").unwrap();
+    let k = keep.to_str().unwrap();
+    let csv = temp("same.csv");
+    let c = csv.to_str().unwrap();
+    let missing = "/nonexistent-jostle-dir/t.csv";
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["run", s, "--steps", "3", "--trace", s],
+            "the scene being run",
+        ),
+        (
+            vec!["run", s, "--steps", "3", "--snapshot", s],
+            "the scene being run",
+        ),
+        (
+            vec!["run", s, "--steps", "3", "--trace", c, "--render", c],
+            "writes the same file",
+        ),
+        (
+            vec!["run", s, "--steps", "3", "--render", k, "--trace", missing],
+            "--trace",
+        ),
+        (
+            vec![
+                "run",
+                s,
+                "--steps",
+                "3",
+                "--snapshot",
+                "/nonexistent-jostle-dir/s.ron",
+            ],
+            "--snapshot",
+        ),
+        (
+            vec!["run", s, "--steps", "3", "--render", k, "--fps", "0"],
+            "--fps",
+        ),
+    ];
+    for (args, expect) in cases {
+        let out = jostle().args(&args).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert!(stderr.contains(expect), "{args:?}: {stderr}");
+        assert_eq!(
+            std::fs::read_to_string(&scene).unwrap(),
+            text,
+            "{args:?} changed the scene"
+        );
+        assert_eq!(
+            std::fs::read(&keep).unwrap(),
+            b"precious",
+            "{args:?} touched keep.png"
+        );
+        assert!(!csv.exists(), "{args:?} wrote {c}");
+    }
+    // A fine run with a new output still works and leaves the scene alone.
+    let out = jostle()
+        .args(["run", s, "--steps", "3", "--trace", c])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(std::fs::read_to_string(&csv).unwrap().lines().count() > 1);
+    assert_eq!(std::fs::read_to_string(&scene).unwrap(), text);
+}
