@@ -324,9 +324,14 @@ impl Scene {
                 .validate()
                 .map_err(|(field, message)| setting(&field, message))?;
         }
-        if let Some(ResolverChoice::SoftStep(soft)) = &self.resolver {
-            soft.validate()
-                .map_err(|(field, message)| setting(&format!("resolver.{field}"), message))?;
+        match &self.resolver {
+            Some(ResolverChoice::SoftStep(soft)) => soft
+                .validate()
+                .map_err(|(field, message)| setting(&format!("resolver.{field}"), message))?,
+            Some(ResolverChoice::Millington(m)) => m
+                .validate()
+                .map_err(|(field, message)| setting(&format!("resolver.{field}"), message))?,
+            None => {}
         }
         for body in &self.bodies {
             body.to_desc().map_err(|e| SceneError::Body {

@@ -263,6 +263,30 @@ fn every_bad_input_exits_non_zero_with_a_precise_message() {
             &["resolver.contact_hertz", "-30"],
         ),
         (
+            "zero-hertz soft contacts",
+            "Scene(resolver: SoftStep(static_hertz: 0.0))".into(),
+            vec![],
+            &["resolver.static_hertz", "> 0"],
+        ),
+        (
+            "Millington relaxation out of range",
+            "Scene(resolver: Millington(relaxation: -1.0))".into(),
+            vec![],
+            &["resolver.relaxation", "-1"],
+        ),
+        (
+            "Millington angular limit negative",
+            "Scene(resolver: Millington(angular_limit: -1.0))".into(),
+            vec![],
+            &["resolver.angular_limit", "-1"],
+        ),
+        (
+            "Millington velocity budget of zero picks",
+            "Scene(resolver: Millington(velocity_iterations: 0))".into(),
+            vec![],
+            &["resolver.velocity_iterations", "at least one pick"],
+        ),
+        (
             "negative --dt",
             "Scene()".into(),
             vec!["--dt=-1"],

@@ -112,8 +112,16 @@ impl SoftStepSettings {
         if self.substeps == 0 {
             return Err(("substeps", "must be >= 1, got 0".into()));
         }
-        non_negative("contact_hertz", self.contact_hertz)?;
-        non_negative("static_hertz", self.static_hertz)?;
+        // A 0 Hz contact has no stiffness at all: bodies sink into each other for good.
+        let positive = |field: &'static str, x: f32| {
+            if x.is_finite() && x > 0.0 {
+                Ok(())
+            } else {
+                Err((field, format!("must be finite and > 0, got {x}")))
+            }
+        };
+        positive("contact_hertz", self.contact_hertz)?;
+        positive("static_hertz", self.static_hertz)?;
         non_negative("damping_ratio", self.damping_ratio)?;
         non_negative("max_push_out", self.max_push_out)?;
         non_negative("push_out_slop", self.push_out_slop)?;
@@ -134,6 +142,11 @@ mod tests {
             ..Default::default()
         };
         assert_eq!(bad.validate().unwrap_err().0, "contact_hertz");
+        let bad = SoftStepSettings {
+            static_hertz: 0.0,
+            ..Default::default()
+        };
+        assert_eq!(bad.validate().unwrap_err().0, "static_hertz");
         let bad = SoftStepSettings {
             substeps: 0,
             ..Default::default()
