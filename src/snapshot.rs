@@ -153,6 +153,31 @@ mod file {
         }
     }
 
+    /// The settings a snapshot may carry: what a scene file would refuse, a snapshot refuses
+    /// too (a hand-edited `substeps: 0` or NaN gravity used to be accepted silently, and a
+    /// negative or NaN `collide.prediction` stopped the process on an assertion in parry).
+    fn validate_settings(settings: &WorldSettings) -> Result<(), String> {
+        use crate::settings::ResolverChoice;
+        let resolver = match &settings.resolver {
+            ResolverChoice::Millington(m) => m.validate(),
+            ResolverChoice::SoftStep(s) => s.validate(),
+        };
+        resolver.map_err(|(field, message)| format!("settings.resolver.{field}: {message}"))?;
+        if !settings.gravity.is_finite() {
+            return Err(format!(
+                "settings.gravity: must be finite, got {}",
+                settings.gravity
+            ));
+        }
+        let prediction = settings.collide.prediction;
+        if !(prediction.is_finite() && prediction >= 0.0) {
+            return Err(format!(
+                "settings.collide.prediction: must be finite and >= 0, got {prediction}"
+            ));
+        }
+        Ok(())
+    }
+
     impl World {
         /// The complete state of the world, for [`World::from_snapshot`]. `scene` and `dt` are
         /// recorded so that a command-line run can continue where it stopped.
@@ -178,6 +203,7 @@ mod file {
                 file: String::new(),
                 message,
             };
+            validate_settings(&snapshot.settings).map_err(invalid)?;
             let mut world = World::new(snapshot.settings);
             world.bodies = snapshot.bodies;
             for (i, record) in snapshot.colliders.into_iter().enumerate() {
@@ -212,6 +238,12 @@ mod file {
             world.narrow = snapshot.narrow;
             world.narrow.rebind_shapes(&world.colliders);
             world.islands = snapshot.islands;
+            if !(snapshot.time.is_finite() && snapshot.time >= 0.0) {
+                return Err(invalid(format!(
+                    "time: must be finite and >= 0, got {}",
+                    snapshot.time
+                )));
+            }
             world.time = snapshot.time;
             world.steps = snapshot.steps;
             Ok(world)

@@ -98,3 +98,43 @@ fn a_snapshot_continues_a_run_bit_for_bit() {
     // Sleep state: the box falls asleep after the snapshot (step ≈ 323) exactly as it would.
     snapshot_continues_exactly("box_drop.ron", 200, 200);
 }
+
+/// A snapshot edited by hand into settings a scene file would refuse is refused too, naming
+/// the setting, instead of running with them (`substeps: 0`, NaN gravity) or stopping the
+/// process on an assertion in parry (a negative `collide.prediction`) (issue 16).
+#[test]
+fn a_snapshot_with_invalid_settings_is_refused_by_name() {
+    let s = scene("box_drop.ron");
+    let mut world = s.build().unwrap();
+    world.step(DT).unwrap();
+    let path = std::env::temp_dir().join(format!("jostle-bad-snapshot-{}", std::process::id()));
+    world.snapshot(&s.name, DT).save(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::remove_file(&path).ok();
+    assert!(World::from_snapshot(Snapshot::parse(&text, "good").unwrap()).is_ok());
+    let edits = [
+        ("substeps: 4", "substeps: 0", "settings.resolver.substeps"),
+        (
+            "prediction: 0.02",
+            "prediction: -1.0",
+            "settings.collide.prediction",
+        ),
+        (
+            "gravity: Vec3(0.0, -9.81, 0.0)",
+            "gravity: Vec3(NaN, -9.81, 0.0)",
+            "settings.gravity",
+        ),
+    ];
+    for (from, to, field) in edits {
+        assert!(
+            text.contains(from),
+            "the snapshot text has no `{from}`:\n{text}"
+        );
+        let bad = text.replacen(from, to, 1);
+        let err = match World::from_snapshot(Snapshot::parse(&bad, "bad").unwrap()) {
+            Ok(_) => panic!("`{to}` was accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(err.contains(field), "`{to}`: {err}");
+    }
+}

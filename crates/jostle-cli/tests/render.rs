@@ -12,9 +12,11 @@ fn temp(name: &str) -> PathBuf {
     dir.join(name)
 }
 
-/// A ball dropped from 3 m onto the ground, with a fixed camera.
-fn drop_scene() -> PathBuf {
-    let path = temp("drop.ron");
+/// A ball dropped from 3 m onto the ground, with a fixed camera, in a file of its own per
+/// test (`tag`): tests run in parallel, and one rewriting a shared file while another read it
+/// made the reader fail now and then.
+fn drop_scene(tag: &str) -> PathBuf {
+    let path = temp(&format!("drop-{tag}.ron"));
     std::fs::write(
         &path,
         "Scene(name: \"drop\", steps: 40, camera: Camera(position: (0.0, 2.0, 8.0), target: (0.0, 1.5, 0.0)), bodies: [
@@ -52,7 +54,7 @@ fn gif_frames(path: &PathBuf) -> Vec<image::Frame> {
 
 #[test]
 fn png_of_the_last_frame_at_the_requested_size() {
-    let (scene, png) = (drop_scene(), temp("last.png"));
+    let (scene, png) = (drop_scene("png"), temp("last.png"));
     let out = jostle(&[
         "run",
         scene.to_str().unwrap(),
@@ -70,7 +72,7 @@ fn png_of_the_last_frame_at_the_requested_size() {
 
 #[test]
 fn gif_frame_count_follows_frame_every_and_fps() {
-    let scene = drop_scene();
+    let scene = drop_scene("gif");
     // Explicit K: the states after steps 0, 10, 20, 30, 40.
     let gif = temp("every10.gif");
     ok(&jostle(&[
@@ -123,7 +125,7 @@ fn gif_frame_count_follows_frame_every_and_fps() {
 
 #[test]
 fn bad_render_flags_fail_with_a_clear_message() {
-    let scene = drop_scene();
+    let scene = drop_scene("flags");
     let s = scene.to_str().unwrap();
     let jpg = temp("x.jpg");
     let gif = temp("x.gif");
