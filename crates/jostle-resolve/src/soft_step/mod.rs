@@ -366,8 +366,7 @@ impl Resolver for SoftStepResolver {
             self.inv_inertia_now
                 .extend(bodies.iter().zip(&self.states).map(|(b, s)| {
                     if b.rotates() {
-                        let r = Mat3::from_quat(s.delta_rotation);
-                        r * b.inv_inertia * r.transpose()
+                        gyroscopic::rotate_inertia(b.inv_inertia, s.delta_rotation)
                     } else {
                         Mat3::ZERO
                     }
