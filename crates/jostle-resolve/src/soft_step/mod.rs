@@ -21,8 +21,9 @@
 //!    faster than the threshold, swept to convergence with the rest of the contacts, through
 //!    each body's inertia as it has turned since the start of the step
 //!    ([`solve::restitution_response`]), leaving alone points that were separating at the start
-//!    of the step, and bounded so that a body bouncing only off immovable bodies ends the step
-//!    with no more mechanical energy than it began with (`bound_bounce_energy`);
+//!    of the step, and bounded: its change to a body bouncing only off immovable bodies is
+//!    scaled back until that body has no more mechanical energy than at the start of the step
+//!    (to nothing, where the substeps alone already exceeded it; `bound_bounce_energy`);
 //! 4. store the impulses and the remaining penetration in the contacts, the poses and
 //!    velocities in the bodies.
 //!
@@ -184,11 +185,12 @@ impl SoftStepResolver {
     }
 
     /// The energy bound of the restitution pass: a body that bounced this step only off
-    /// bodies that cannot move ends the step with no more mechanical energy than it began
-    /// with, K_end ≤ K_start + m·g·Δx (e ≤ 1 returns at most what the impact took, and the
-    /// substeps' symplectic integration of gravity alone never exceeds this). Where the pass
-    /// gave more, the velocity change it made to that body is scaled back to the largest
-    /// fraction that meets the bound.
+    /// bodies that cannot move should end the step with no more mechanical energy than it
+    /// began with, K_end ≤ K_start + m·g·Δx (e ≤ 1 returns at most what the impact took, and
+    /// the substeps' symplectic integration of gravity alone never exceeds this). Where the
+    /// pass gave more, the velocity change it made to that body is scaled back to the largest
+    /// fraction that meets the bound, or to nothing where the substeps alone already exceeded
+    /// it (the bound limits this pass, not the substeps).
     ///
     /// Why: the pass reflects each point's approach velocity at the start of the step, at the
     /// poses the substeps left. A body that turned a large angle within the step (a 0.1 m
