@@ -175,6 +175,12 @@ mod file {
                 "settings.collide.prediction: must be finite and >= 0, got {prediction}"
             ));
         }
+        let frame = settings.collide.frame_tolerance;
+        if !(frame.is_finite() && frame >= 0.0) {
+            return Err(format!(
+                "settings.collide.frame_tolerance: must be finite and >= 0, got {frame}"
+            ));
+        }
         Ok(())
     }
 

@@ -121,6 +121,7 @@ pub(crate) fn gather(
             .with_friction(c.friction)
             .with_restitution(c.restitution);
         contact.impulse = c.impulse;
+        contact.point_b = c.point_b;
         scratch.contacts.push(contact);
         scratch.contact_source.push(i as u32);
     }

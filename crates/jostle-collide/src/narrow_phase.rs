@@ -34,8 +34,11 @@ pub struct BodyContact {
     pub a: BodyHandle,
     /// Body B.
     pub b: BodyHandle,
-    /// World contact point, midway between the two surfaces (m).
+    /// World contact point, midway between the two surfaces (m); while the point's frame is
+    /// held ([`CollideSettings::frame_tolerance`]), A's centre plus the held lever arm.
     pub point: Vec3,
+    /// Where the contact acts on B (m): `point`, or B's centre plus B's held lever arm.
+    pub point_b: Vec3,
     /// Unit world normal from B toward A: the direction A must move to separate.
     pub normal: Vec3,
     /// Penetration depth along the normal (m): positive on overlap, negative (the separation)
@@ -80,6 +83,41 @@ pub struct NarrowStats {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct PointData {
     impulse: Vec3,
+    /// The point's held contact frame ([`CollideSettings::frame_tolerance`]); `None` until
+    /// first taken, or with the tolerance 0.
+    #[cfg_attr(feature = "serde", serde(default))]
+    frame: Option<Frame>,
+}
+
+/// A contact point's frame as the resolver sees it: the normal and the lever arms from each
+/// body's centre of mass, all in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+struct Frame {
+    normal: Vec3,
+    r_a: Vec3,
+    r_b: Vec3,
+}
+
+impl Frame {
+    /// The frame to use now, given the fresh one: the held frame while both lever arms are
+    /// within `tolerance` of it and the normal within about `tolerance` radians, else the
+    /// fresh one (which is then held).
+    fn hold(held: &mut Option<Frame>, fresh: Frame, tolerance: f32) -> Frame {
+        match *held {
+            Some(f)
+                if f.r_a.distance_squared(fresh.r_a) < tolerance * tolerance
+                    && f.r_b.distance_squared(fresh.r_b) < tolerance * tolerance
+                    && f.normal.dot(fresh.normal) > 1.0 - 0.5 * tolerance * tolerance =>
+            {
+                f
+            }
+            _ => {
+                *held = (tolerance > 0.0).then_some(fresh);
+                fresh
+            }
+        }
+    }
 }
 
 type Manifold = ContactManifold<(), PointData>;
@@ -299,9 +337,10 @@ impl NarrowPhase {
                 (c1.body, c2.body)
             };
             let material = Material::mix(c1.material, c2.material);
+            let (body_a, body_b) = if flip { (b2, b1) } else { (b1, b2) };
             let pair_index = self.pairs.len() as u32;
             let mut touches = false;
-            for (mi, m) in state.manifolds.iter().enumerate() {
+            for (mi, m) in state.manifolds.iter_mut().enumerate() {
                 let w1 = m.subshape_pos1().map_or(pose1, |sub| pose1 * sub);
                 let w2 = m.subshape_pos2().map_or(pose2, |sub| pose2 * sub);
                 // parry's normal points out of shape 1, toward shape 2.
@@ -313,15 +352,23 @@ impl NarrowPhase {
                 }
                 stats.manifolds += 1;
                 let normal = if flip { n1 } else { -n1 };
-                for (pi, pt) in m.points.iter().enumerate() {
+                for (pi, pt) in m.points.iter_mut().enumerate() {
                     let p1 = w1 * pt.local_p1;
                     let p2 = w2 * pt.local_p2;
                     touches |= pt.dist <= 0.0;
+                    let point = (p1 + p2) * 0.5;
+                    let fresh = Frame {
+                        normal,
+                        r_a: point - body_a.position,
+                        r_b: point - body_b.position,
+                    };
+                    let frame = Frame::hold(&mut pt.data.frame, fresh, settings.frame_tolerance);
                     self.contacts.push(BodyContact {
                         a,
                         b,
-                        point: (p1 + p2) * 0.5,
-                        normal,
+                        point: body_a.position + frame.r_a,
+                        point_b: body_b.position + frame.r_b,
+                        normal: frame.normal,
                         penetration: -pt.dist,
                         friction: material.friction,
                         restitution: material.restitution,

@@ -19,6 +19,17 @@ pub struct CollideSettings {
     pub reuse_linear: f32,
     /// Angular reuse tolerance (rad). Default 1e-4. See `reuse_linear`.
     pub reuse_angular: f32,
+    /// Contact-frame tolerance (m). Default 0.002.
+    ///
+    /// A contact point that persists (same features) keeps the normal and the two lever arms
+    /// (its offsets from each body's centre of mass, in world space) it had when they were
+    /// last taken, until either lever arm has moved more than this or the normal has turned
+    /// more than about this many radians; then they are taken again. Contact forces that do
+    /// not turn with small sways of the bodies do not feed those sways (a tall column whose
+    /// contacts follow every tilt leans further under its own weight, see the `jostle`
+    /// crate's ARCHITECTURE.md). 0 takes them fresh every update.
+    #[cfg_attr(feature = "serde", serde(default = "default_frame_tolerance"))]
+    pub frame_tolerance: f32,
     /// Continuous collision detection ([`crate::ccd`]). Default: enabled.
     #[cfg_attr(feature = "serde", serde(default))]
     pub ccd: CcdSettings,
@@ -66,7 +77,13 @@ impl Default for CollideSettings {
             prediction: 0.02,
             reuse_linear: 1e-4,
             reuse_angular: 1e-4,
+            frame_tolerance: default_frame_tolerance(),
             ccd: CcdSettings::default(),
         }
     }
+}
+
+/// [`CollideSettings::frame_tolerance`]'s default (m).
+fn default_frame_tolerance() -> f32 {
+    0.002
 }

@@ -8,7 +8,10 @@ use jostle_math::Vec3;
 /// Convention (the seed's and Cyclone's): `normal` is unit and points from B toward A, the
 /// direction A must move to separate; `penetration` is positive when the bodies overlap and
 /// negative when they are apart by that distance (speculative contacts). `point` is the world
-/// position of the contact, midway between the two surfaces.
+/// position of the contact, midway between the two surfaces. `point_b` is where the contact
+/// acts on B: `point` itself, unless the narrow phase holds the pair's contact frame (then
+/// `point − a`'s centre and `point_b − b`'s centre are the lever arms it froze, which differ
+/// by as much as the bodies moved apart since).
 ///
 /// `impulse` is the impulse this contact applied to A during the last step, in contact space:
 /// x along the normal, y and z along the tangents of [`jostle_math::contact_basis`] of
@@ -35,9 +38,11 @@ pub struct Contact {
     pub a: u32,
     /// Index of body B in the solver-body slice.
     pub b: u32,
+    /// World-space point where the contact acts on B (m): `point` unless the frame is frozen.
+    pub point_b: Vec3,
 }
 
-const _: () = assert!(size_of::<Contact>() <= 64);
+const _: () = assert!(size_of::<Contact>() <= 68);
 
 impl Contact {
     /// A contact with no stored impulse.
@@ -51,6 +56,7 @@ impl Contact {
             restitution: 0.0,
             a,
             b,
+            point_b: point,
         }
     }
 

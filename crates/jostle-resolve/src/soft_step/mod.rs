@@ -27,6 +27,12 @@
 //! 4. store the impulses and the remaining penetration in the contacts, the poses and
 //!    velocities in the bodies.
 //!
+//! With [`SoftStepSettings::rigid_contacts`] there is no spring: the biased pass solves each
+//! manifold's normal rows rigidly, [`SoftStepSettings::normal_sweeps`] times, then friction,
+//! and all overlap beyond [`SoftStepSettings::rigid_slop`] goes to the pseudo velocities at
+//! [`SoftStepSettings::push_out_rate`] ([`solve::solve`]); the relax pass sweeps the normal
+//! rows as often. A loaded contact then sinks no deeper than the slop, whatever its load.
+//!
 //! Unlike the Millington resolver there is no position projection: a resting contact's
 //! overlap (its spring's compression under its load, plus
 //! [`SoftStepSettings::push_out_slop`] and one substep of gravity) is removed by the soft
@@ -260,6 +266,11 @@ impl SoftStepResolver {
         } else {
             0.0
         };
+        let (fixed, dynamic) = if s.rigid_contacts {
+            (Softness::RIGID, Softness::RIGID)
+        } else {
+            (fixed, dynamic)
+        };
         let params = PrepareParams {
             static_softness: fixed,
             dynamic_softness: dynamic,
@@ -301,6 +312,12 @@ impl Resolver for SoftStepResolver {
         let mut solve_time = Duration::ZERO;
         let mut relax_time = Duration::ZERO;
         let push_out = self.settings.max_push_out;
+        let rigid = self.settings.rigid_contacts;
+        let sweeps = if rigid {
+            self.settings.normal_sweeps.max(1)
+        } else {
+            1
+        };
         for _ in 0..substeps {
             let t = Instant::now();
             if self.settings.gyroscopic {
@@ -324,11 +341,19 @@ impl Resolver for SoftStepResolver {
                 solve::BiasedPass {
                     inv_h,
                     max_push_out: push_out,
-                    slop: self.settings.push_out_slop,
+                    slop: if rigid {
+                        self.settings.rigid_slop
+                    } else {
+                        self.settings.push_out_slop
+                    },
                     resting_speed: self.settings.restitution_threshold,
                     gravity_speed: ctx.gravity.length() * h,
                     friction: self.settings.friction_in_bias_pass
-                        || self.settings.relax_iterations == 0,
+                        || self.settings.relax_iterations == 0
+                        || rigid,
+                    rigid,
+                    sweeps,
+                    rate: self.settings.push_out_rate * inv_h,
                 },
             );
             solve_time += t.elapsed();
@@ -339,7 +364,7 @@ impl Resolver for SoftStepResolver {
 
             let t = Instant::now();
             for _ in 0..self.settings.relax_iterations {
-                solve::relax(&mut self.batches, &mut self.states, inv_h);
+                solve::relax(&mut self.batches, &mut self.states, inv_h, sweeps);
             }
             relax_time += t.elapsed();
         }

@@ -94,7 +94,7 @@ pub fn prepare_point<F: Lane>(
 ) {
     // Lane by lane into arrays, then one load per component (writing lanes of a vector one
     // at a time would stall the load that follows on every store).
-    let mut vectors = [[Vec3::ZERO; WIDTH]; 3];
+    let mut vectors = [[Vec3::ZERO; WIDTH]; 4];
     let mut present = [0.0; WIDTH];
     let mut penetration = [0.0; WIDTH];
     let mut friction = [0.0; WIDTH];
@@ -104,6 +104,7 @@ pub fn prepare_point<F: Lane>(
             vectors[0][lane] = c.normal;
             vectors[1][lane] = c.point;
             vectors[2][lane] = c.impulse;
+            vectors[3][lane] = c.point_b;
             present[lane] = 1.0;
             penetration[lane] = c.penetration;
             friction[lane] = c.friction;
@@ -112,10 +113,11 @@ pub fn prepare_point<F: Lane>(
     }
     // No closures over lanes here or below: a closure is not compiled with the target
     // features of the kernel it sits in, so every lane operation in it would be a call.
-    let [n, point, stored] = [
+    let [n, point, stored, point_b] = [
         V3x8::<F>::from_lanes(vectors[0]),
         V3x8::from_lanes(vectors[1]),
         V3x8::from_lanes(vectors[2]),
+        V3x8::from_lanes(vectors[3]),
     ];
     // `contact_basis` lane by lane, the same operations in the same order: t₁ = n × a
     // normalised, with a = x̂ unless |n.x| ≥ 0.6 (then ŷ), and t₂ = n × t₁. Padding lanes
@@ -132,7 +134,7 @@ pub fn prepare_point<F: Lane>(
     let t2 = n.cross(t1);
     let (t1, t2) = (zero_unless(present, t1), zero_unless(present, t2));
     let r_a = point - a.position;
-    let r_b = point - b.position;
+    let r_b = point_b - b.position;
     let m = a.inv_mass + b.inv_mass;
 
     let (rn_a, rn_b) = (r_a.cross(n), r_b.cross(n));

@@ -18,7 +18,7 @@
 //! written. Every branch on a contact's state is a lane-wise select, so a lane's result does
 //! not depend on its neighbours.
 
-use super::batch::{Batches, LANES, ManifoldLanes, PointLanes};
+use super::batch::{Batches, LANES, MAX_POINTS, ManifoldLanes, PointLanes};
 use super::body_state::{BodyState, PseudoRow};
 use super::lanes::{F8, Lane, LaneMask, Q8, V3x8};
 use crate::STATIC_BODY;
@@ -401,7 +401,8 @@ fn accumulate_normal<F: Lane>(pair: &mut Pair<F>, p: &mut PointLanes<F>, delta: 
 }
 
 /// The relax pass over one batch: every point's normal row rigid and unbiased (a
-/// speculative point keeps its gap rule), then its friction.
+/// speculative point keeps its gap rule), then its friction; with `sweeps` > 1 (rigid
+/// contacts) all the normal rows `sweeps` times first, then the friction.
 #[inline(always)]
 fn relax_batch<F: Lane>(
     m: &ManifoldLanes<F>,
@@ -409,9 +410,27 @@ fn relax_batch<F: Lane>(
     points: &mut [PointLanes<F>],
     states: &[BodyState],
     inv_h: f32,
+    sweeps: u32,
 ) {
     let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
     let inv_h = F::splat(inv_h);
+    if sweeps > 1 {
+        // Rigid contacts: the normal rows first, `sweeps` times, then friction.
+        for _ in 0..sweeps {
+            for p in points.iter_mut() {
+                let s = separation(p, &motion_a, &motion_b);
+                let bias = F::select(s.cmpgt(F::ZERO), s * inv_h, F::ZERO);
+                let vn = pair.relative_velocity(p).dot(p.normal);
+                accumulate_normal(pair, p, -p.normal_mass * (vn + bias));
+            }
+        }
+        if m.friction {
+            for p in points.iter_mut() {
+                solve_friction(pair, p);
+            }
+        }
+        return;
+    }
     for p in points.iter_mut() {
         let s = separation(p, &motion_a, &motion_b);
         let bias = F::select(s.cmpgt(F::ZERO), s * inv_h, F::ZERO);
@@ -440,6 +459,82 @@ pub struct BiasedPass {
     pub gravity_speed: f32,
     /// Solve friction too ([`super::SoftStepSettings::friction_in_bias_pass`]).
     pub friction: bool,
+    /// Rigid contacts ([`super::SoftStepSettings::rigid_contacts`]): `solve_batch_rigid`
+    /// instead of `solve_batch_split`, with `slop` the overlap left alone.
+    pub rigid: bool,
+    /// Sweeps over a manifold's normal rows ([`super::SoftStepSettings::normal_sweeps`]).
+    pub sweeps: u32,
+    /// Push-out rate of rigid contacts (1/s):
+    /// [`super::SoftStepSettings::push_out_rate`] / h.
+    pub rate: f32,
+}
+
+/// The biased pass over one batch with rigid contacts
+/// ([`super::SoftStepSettings::rigid_contacts`]): the normal rows rigid and unbiased (a
+/// speculative point keeps its gap rule) in `pass.sweeps` Gauss-Seidel sweeps over the
+/// manifold, then friction; then the overlap beyond `pass.slop` is pushed out at `pass.rate`
+/// (at most `max_push_out`) through the pseudo velocities, again in `pass.sweeps` sweeps with
+/// each point's pseudo impulse accumulated and kept ≥ 0. Nothing of the push-out reaches
+/// real velocity, and no spring lets a loaded contact sink: the overlap a step leaves is the
+/// slop plus what the unconverged solve let through.
+#[inline(always)]
+fn solve_batch_rigid<F: Lane>(
+    m: &ManifoldLanes<F>,
+    pair: &mut Pair<F>,
+    pseudo: &mut (Velocities<F>, Velocities<F>),
+    live: &mut bool,
+    points: &mut [PointLanes<F>],
+    states: &[BodyState],
+    pass: BiasedPass,
+) {
+    let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
+    let inv_h = F::splat(pass.inv_h);
+    let push_out = F::splat(pass.max_push_out);
+    let slop = F::splat(pass.slop);
+    let rate = F::splat(pass.rate);
+    debug_assert!(points.len() <= MAX_POINTS);
+    for _ in 0..pass.sweeps {
+        for p in points.iter_mut() {
+            let s = separation(p, &motion_a, &motion_b);
+            let bias = F::select(s.cmpgt(F::ZERO), s * inv_h, F::ZERO);
+            let vn = pair.relative_velocity(p).dot(p.normal);
+            accumulate_normal(pair, p, -p.normal_mass * (vn + bias));
+        }
+    }
+    if pass.friction && m.friction {
+        for p in points.iter_mut() {
+            solve_friction(pair, p);
+        }
+    }
+    let mut any = *live;
+    let mut targets = [F::ZERO; MAX_POINTS];
+    for (p, t) in points.iter().zip(targets.iter_mut()) {
+        let s = separation(p, &motion_a, &motion_b);
+        let x = ((-s - slop) * rate).max(F::ZERO);
+        *t = F::select(x.cmpgt(push_out), push_out, x);
+        any |= t.cmpgt(F::ZERO).any();
+    }
+    if !any {
+        return;
+    }
+    *live = true;
+    let mut acc = [F::ZERO; MAX_POINTS];
+    for _ in 0..pass.sweeps {
+        for ((p, &t), acc) in points.iter().zip(targets.iter()).zip(acc.iter_mut()) {
+            let (pa, pb) = (&pseudo.0, &pseudo.1);
+            let vpn = ((pa.linear + pa.angular.cross(p.r_a))
+                - (pb.linear + pb.angular.cross(p.r_b)))
+            .dot(p.normal);
+            let total = (*acc + p.normal_mass * (t - vpn)).max(F::ZERO);
+            let push = total - *acc;
+            *acc = total;
+            let impulse = p.normal * push;
+            pseudo.0.linear += impulse * pair.inv_mass_a;
+            pseudo.0.angular += p.ang_a_normal * push;
+            pseudo.1.linear -= impulse * pair.inv_mass_b;
+            pseudo.1.angular -= p.ang_b_normal * push;
+        }
+    }
 }
 
 /// The biased pass over one batch, with split impulses for overlap beyond what the load
@@ -483,6 +578,7 @@ fn solve_batch_split<F: Lane>(
         resting_speed,
         gravity_speed,
         friction,
+        ..
     } = pass;
     let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
     let inv_h = F::splat(inv_h);
@@ -548,7 +644,11 @@ fn solve_impl<F: Lane>(
             let zero = Velocities::from_columns([F::ZERO; 8]);
             (zero, zero)
         };
-        solve_batch_split(m, pair, &mut split, &mut live, points, states, pass);
+        if pass.rigid {
+            solve_batch_rigid(m, pair, &mut split, &mut live, points, states, pass);
+        } else {
+            solve_batch_split(m, pair, &mut split, &mut live, points, states, pass);
+        }
         if live {
             scatter_pseudo(pseudo, m.a, &split.0);
             scatter_pseudo(pseudo, m.b, &split.1);
@@ -561,7 +661,8 @@ wide_kernel! {
     /// own softness, the push-out of overlap beyond the load's (and beyond the allowance of
     /// resting contacts; at most `max_push_out`, m/s) in the pseudo velocities `pseudo` (one
     /// [`PseudoRow`] per body, zero at the start of the pass), with friction when
-    /// [`BiasedPass::friction`] is set.
+    /// [`BiasedPass::friction`] is set; with [`BiasedPass::rigid`], rigid rows and the
+    /// push-out of all overlap beyond the slop (`solve_batch_rigid`).
     pub fn solve(batches: &mut Batches, states: &mut [BodyState], pseudo: &mut [PseudoRow], pass: BiasedPass) -> () = solve_impl;
 }
 
@@ -571,17 +672,19 @@ fn relax_impl<F: Lane>(
     points: &mut [PointLanes<F>],
     states: &mut [BodyState],
     inv_h: f32,
+    sweeps: u32,
 ) {
     for_each_batch!(manifolds, points, states, |m, pair, points, states| {
-        relax_batch(m, pair, points, states, inv_h);
+        relax_batch(m, pair, points, states, inv_h, sweeps);
     });
 }
 
 wide_kernel! {
     /// One relax pass: rigid, without bias, so the velocity the soft constraints' bleed let
     /// through is removed again once the positions moved (speculative contacts keep their gap
-    /// rule).
-    pub fn relax(batches: &mut Batches, states: &mut [BodyState], inv_h: f32) -> () = relax_impl;
+    /// rule); `sweeps` > 1 sweeps each manifold's normal rows that often before its friction
+    /// (rigid contacts).
+    pub fn relax(batches: &mut Batches, states: &mut [BodyState], inv_h: f32, sweeps: u32) -> () = relax_impl;
 }
 
 /// Lanes of `p` that bounce in the restitution pass: e > 0, approached faster than
@@ -839,14 +942,31 @@ mod tests {
     /// the CPU supports is run: the detected one, at most AVX, and the 128-bit dispatch.
     #[test]
     fn the_wide_kernels_match_the_128_bit_ones_bit_for_bit() {
-        const PASS: BiasedPass = BiasedPass {
+        const SOFT: BiasedPass = BiasedPass {
             inv_h: 4.0 / DT,
             max_push_out: 3.0,
             slop: 0.005,
             resting_speed: 1.0,
             gravity_speed: 9.81 / 240.0,
             friction: false,
+            rigid: false,
+            sweeps: 1,
+            rate: 0.2 * 4.0 / DT,
         };
+        // Rigid contacts: other kernels, several sweeps, friction in the biased pass.
+        const RIGID: BiasedPass = BiasedPass {
+            slop: 0.001,
+            friction: true,
+            rigid: true,
+            sweeps: 3,
+            ..SOFT
+        };
+        for pass in [SOFT, RIGID] {
+            kernels_match(pass);
+        }
+    }
+
+    fn kernels_match(pass: BiasedPass) {
         let (batches, states) = pile();
         assert!(batches.contacts > 1000);
         let inv_h = 4.0 / DT;
@@ -862,9 +982,9 @@ mod tests {
             points,
             &mut narrow_states,
             &mut narrow_pseudo,
-            PASS,
+            pass,
         );
-        relax_impl::<F8>(manifolds, points, &mut narrow_states, inv_h);
+        relax_impl::<F8>(manifolds, points, &mut narrow_states, inv_h, pass.sweeps);
         // The pile starts overlapping, so the split push-out did work too.
         assert!(narrow_pseudo.iter().flatten().any(|&x| x != 0.0));
         let mut narrow = bits(&narrow_states, &narrow_batches);
@@ -883,8 +1003,8 @@ mod tests {
             let (mut batches, mut states) = (batches.clone(), states.clone());
             let mut pseudo = vec![[0.0; 8]; states.len()];
             warm_start(&mut batches, &mut states);
-            solve(&mut batches, &mut states, &mut pseudo, PASS);
-            relax(&mut batches, &mut states, inv_h);
+            solve(&mut batches, &mut states, &mut pseudo, pass);
+            relax(&mut batches, &mut states, inv_h, pass.sweeps);
             let mut wide = bits(&states, &batches);
             wide.extend(pseudo.iter().flatten().map(|x| x.to_bits()));
             assert_eq!(wide.len(), narrow.len());
