@@ -73,10 +73,17 @@ fn check_stack(
             "{what}: penetration {} != {depth}",
             c.penetration
         );
+        // Each body's point on its own surface: the upper body's lowest, the lower's highest.
+        let (on_upper, on_lower) = if c.a == upper {
+            (c.point, c.point_b)
+        } else {
+            (c.point_b, c.point)
+        };
         assert!(
-            (c.point.y - (0.5 - depth / 2.0)).abs() < 0.01,
-            "{what}: point {} not between the surfaces",
-            c.point
+            (on_upper.y - (0.5 - depth)).abs() < 0.01 && (on_lower.y - 0.5).abs() < 0.01,
+            "{what}: points {} (A) and {} (B) not on the surfaces",
+            c.point,
+            c.point_b
         );
     }
 }
@@ -174,9 +181,10 @@ fn resting_cube_on_a_half_space_has_four_corner_points() {
                 c.point
             );
             assert!(
-                (c.point.y + 0.005).abs() < 1e-4,
-                "midway between the surfaces: {}",
-                c.point
+                (c.point.y + 0.01).abs() < 1e-4 && c.point_b.y.abs() < 1e-4,
+                "the cube's corner and the ground under it: {} and {}",
+                c.point,
+                c.point_b
             );
             (local.x.signum() as i32, local.z.signum() as i32)
         })
@@ -225,9 +233,11 @@ fn ball_on_a_half_space_has_one_point_under_its_centre() {
     assert_eq!(c.len(), 1);
     assert_eq!(c[0].a, ball);
     assert!(
-        (c[0].point - Vec3::new(3.0, -0.005, -2.0)).length() < 1e-4,
-        "{}",
-        c[0].point
+        (c[0].point - Vec3::new(3.0, -0.01, -2.0)).length() < 1e-4
+            && (c[0].point_b - Vec3::new(3.0, 0.0, -2.0)).length() < 1e-4,
+        "{} {}",
+        c[0].point,
+        c[0].point_b
     );
     assert!((c[0].penetration - 0.01).abs() < 1e-4);
 }
@@ -280,12 +290,12 @@ fn compound_parts_each_touch_in_their_own_frame() {
     c.sort_by(|a, b| a.point.z.total_cmp(&b.point.z));
     // Local ±X maps to ∓Z under a quarter turn about Y.
     assert!(
-        (c[0].point - Vec3::new(0.0, -0.005, -1.0)).length() < 1e-3,
+        (c[0].point - Vec3::new(0.0, -0.01, -1.0)).length() < 1e-3,
         "{}",
         c[0].point
     );
     assert!(
-        (c[1].point - Vec3::new(0.0, -0.005, 1.0)).length() < 1e-3,
+        (c[1].point - Vec3::new(0.0, -0.01, 1.0)).length() < 1e-3,
         "{}",
         c[1].point
     );

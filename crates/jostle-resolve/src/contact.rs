@@ -7,11 +7,10 @@ use jostle_math::Vec3;
 ///
 /// Convention (the seed's and Cyclone's): `normal` is unit and points from B toward A, the
 /// direction A must move to separate; `penetration` is positive when the bodies overlap and
-/// negative when they are apart by that distance (speculative contacts). `point` is the world
-/// position of the contact, midway between the two surfaces. `point_b` is where the contact
-/// acts on B: `point` itself, unless the narrow phase holds the pair's contact frame (then
-/// `point − a`'s centre and `point_b − b`'s centre are the lever arms it froze, which differ
-/// by as much as the bodies moved apart since).
+/// negative when they are apart by that distance (speculative contacts). `point` is where the
+/// contact acts on A and `point_b` where it acts on B, in world space: the narrow phase gives
+/// each body's own surface point (or, while it holds the point's frame, each body's centre
+/// plus the lever arm it held); [`Contact::new`] sets both to the one point given.
 ///
 /// `impulse` is the impulse this contact applied to A during the last step, in contact space:
 /// x along the normal, y and z along the tangents of [`jostle_math::contact_basis`] of
@@ -21,7 +20,7 @@ use jostle_math::Vec3;
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct Contact {
-    /// World-space contact point (m).
+    /// World-space point where the contact acts on A (m).
     pub point: Vec3,
     /// Penetration depth (m), positive when overlapping.
     pub penetration: f32,
@@ -38,7 +37,7 @@ pub struct Contact {
     pub a: u32,
     /// Index of body B in the solver-body slice.
     pub b: u32,
-    /// World-space point where the contact acts on B (m): `point` unless the frame is frozen.
+    /// World-space point where the contact acts on B (m).
     pub point_b: Vec3,
 }
 

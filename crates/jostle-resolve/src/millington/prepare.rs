@@ -248,7 +248,7 @@ pub fn prepare(
     let basis = contact_basis(n);
     let r = [
         contact.point - body_a.position,
-        contact.point - body_b.position,
+        contact.point_b - body_b.position,
     ];
     let body = [
         moving_side(bodies, contact.a),

@@ -400,6 +400,46 @@ fn accumulate_normal<F: Lane>(pair: &mut Pair<F>, p: &mut PointLanes<F>, delta: 
     pair.apply_normal(p, delta);
 }
 
+/// One rigid, unbiased normal row (a speculative point keeps its gap rule: it may close at
+/// most its gap within the substep), as the relax pass and rigid contacts solve it.
+#[inline(always)]
+fn solve_normal_rigid<F: Lane>(
+    pair: &mut Pair<F>,
+    p: &mut PointLanes<F>,
+    motion: (&Motion<F>, &Motion<F>),
+    inv_h: F,
+) {
+    let s = separation(p, motion.0, motion.1);
+    let bias = F::select(s.cmpgt(F::ZERO), s * inv_h, F::ZERO);
+    let vn = pair.relative_velocity(p).dot(p.normal);
+    accumulate_normal(pair, p, -p.normal_mass * (vn + bias));
+}
+
+/// The normal velocity of A's point relative to B's under the pseudo velocities (m/s).
+#[inline(always)]
+fn pseudo_normal_velocity<F: Lane>(
+    pseudo: &(Velocities<F>, Velocities<F>),
+    p: &PointLanes<F>,
+) -> F {
+    let (pa, pb) = (&pseudo.0, &pseudo.1);
+    ((pa.linear + pa.angular.cross(p.r_a)) - (pb.linear + pb.angular.cross(p.r_b))).dot(p.normal)
+}
+
+/// Applies the pseudo impulse `push` (on A along n, on B opposite) to the pseudo velocities.
+#[inline(always)]
+fn apply_pseudo<F: Lane>(
+    pseudo: &mut (Velocities<F>, Velocities<F>),
+    pair: &Pair<F>,
+    p: &PointLanes<F>,
+    push: F,
+) {
+    let impulse = p.normal * push;
+    pseudo.0.linear += impulse * pair.inv_mass_a;
+    pseudo.0.angular += p.ang_a_normal * push;
+    pseudo.1.linear -= impulse * pair.inv_mass_b;
+    pseudo.1.angular -= p.ang_b_normal * push;
+}
+
 /// The relax pass over one batch: every point's normal row rigid and unbiased (a
 /// speculative point keeps its gap rule), then its friction; with `sweeps` > 1 (rigid
 /// contacts) all the normal rows `sweeps` times first, then the friction.
@@ -414,14 +454,12 @@ fn relax_batch<F: Lane>(
 ) {
     let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
     let inv_h = F::splat(inv_h);
+    let motion = (&motion_a, &motion_b);
     if sweeps > 1 {
         // Rigid contacts: the normal rows first, `sweeps` times, then friction.
         for _ in 0..sweeps {
             for p in points.iter_mut() {
-                let s = separation(p, &motion_a, &motion_b);
-                let bias = F::select(s.cmpgt(F::ZERO), s * inv_h, F::ZERO);
-                let vn = pair.relative_velocity(p).dot(p.normal);
-                accumulate_normal(pair, p, -p.normal_mass * (vn + bias));
+                solve_normal_rigid(pair, p, motion, inv_h);
             }
         }
         if m.friction {
@@ -432,10 +470,7 @@ fn relax_batch<F: Lane>(
         return;
     }
     for p in points.iter_mut() {
-        let s = separation(p, &motion_a, &motion_b);
-        let bias = F::select(s.cmpgt(F::ZERO), s * inv_h, F::ZERO);
-        let vn = pair.relative_velocity(p).dot(p.normal);
-        accumulate_normal(pair, p, -p.normal_mass * (vn + bias));
+        solve_normal_rigid(pair, p, motion, inv_h);
         if m.friction {
             solve_friction(pair, p);
         }
@@ -495,10 +530,7 @@ fn solve_batch_rigid<F: Lane>(
     debug_assert!(points.len() <= MAX_POINTS);
     for _ in 0..pass.sweeps {
         for p in points.iter_mut() {
-            let s = separation(p, &motion_a, &motion_b);
-            let bias = F::select(s.cmpgt(F::ZERO), s * inv_h, F::ZERO);
-            let vn = pair.relative_velocity(p).dot(p.normal);
-            accumulate_normal(pair, p, -p.normal_mass * (vn + bias));
+            solve_normal_rigid(pair, p, (&motion_a, &motion_b), inv_h);
         }
     }
     if pass.friction && m.friction {
@@ -521,18 +553,10 @@ fn solve_batch_rigid<F: Lane>(
     let mut acc = [F::ZERO; MAX_POINTS];
     for _ in 0..pass.sweeps {
         for ((p, &t), acc) in points.iter().zip(targets.iter()).zip(acc.iter_mut()) {
-            let (pa, pb) = (&pseudo.0, &pseudo.1);
-            let vpn = ((pa.linear + pa.angular.cross(p.r_a))
-                - (pb.linear + pb.angular.cross(p.r_b)))
-            .dot(p.normal);
+            let vpn = pseudo_normal_velocity(pseudo, p);
             let total = (*acc + p.normal_mass * (t - vpn)).max(F::ZERO);
-            let push = total - *acc;
+            apply_pseudo(pseudo, pair, p, total - *acc);
             *acc = total;
-            let impulse = p.normal * push;
-            pseudo.0.linear += impulse * pair.inv_mass_a;
-            pseudo.0.angular += p.ang_a_normal * push;
-            pseudo.1.linear -= impulse * pair.inv_mass_b;
-            pseudo.1.angular -= p.ang_b_normal * push;
         }
     }
 }
@@ -606,16 +630,9 @@ fn solve_batch_split<F: Lane>(
         // Pseudo velocities can only change where some lane has excess overlap or the
         // bodies already move with pseudo velocities (`live`); elsewhere push would be 0.
         if *live || excess.cmplt(F::ZERO).any() {
-            let (pa, pb) = (&pseudo.0, &pseudo.1);
-            let vpn = ((pa.linear + pa.angular.cross(p.r_a))
-                - (pb.linear + pb.angular.cross(p.r_b)))
-            .dot(p.normal);
+            let vpn = pseudo_normal_velocity(pseudo, p);
             let push = (-soft_mass * vpn - excess).max(F::ZERO);
-            let impulse = p.normal * push;
-            pseudo.0.linear += impulse * pair.inv_mass_a;
-            pseudo.0.angular += p.ang_a_normal * push;
-            pseudo.1.linear -= impulse * pair.inv_mass_b;
-            pseudo.1.angular -= p.ang_b_normal * push;
+            apply_pseudo(pseudo, pair, p, push);
             *live = true;
         }
 
