@@ -24,6 +24,9 @@
 //!   sampled after every frame; its unit is the declaration's (metres for trajectories and
 //!   apex heights, m/s for the velocities after a collision). `None` for scenes without one.
 //!   It is measured over the whole run, not only after the settle time.
+//! - **quarantined**: bodies whose state went non-finite during the run and were frozen
+//!   ([`crate::StepReport::quarantined`]). A run with any reports an infinite drift and no time
+//!   to sleep, since the frozen body neither stayed put nor slept.
 //!
 //! Cost is the median wall time of one step (the world's own profile total, so the harness's
 //! bookkeeping is not counted), and the median of one *frame* when a frame is several world
@@ -476,6 +479,10 @@ pub struct Metrics {
     /// The run against the scene's closed form (`None` when the scene declares none); unit
     /// per [`Analytic`] kind.
     pub analytic_error: Option<f64>,
+    /// Bodies quarantined during the run (their state went non-finite and they were frozen,
+    /// [`crate::StepReport::quarantined`]). A run with any has an infinite `drift` and no
+    /// `time_to_sleep`: a frozen body neither stays put nor sleeps.
+    pub quarantined: usize,
 }
 
 /// Why [`run_case`] failed.
@@ -500,12 +507,12 @@ pub fn mechanical_energy(world: &World) -> f64 {
     world.kinetic_energy() + potential
 }
 
-/// Positions of the dynamic bodies, in handle order.
-fn dynamic_positions(world: &World) -> Vec<Vec3> {
-    world
-        .bodies()
-        .filter(|(_, _, b)| !b.is_fixed())
-        .map(|(_, _, b)| b.position)
+/// Positions of `bodies` (the run's dynamic bodies at its start, in handle order; a body
+/// quarantined since keeps its frozen position).
+fn positions(world: &World, bodies: &[BodyHandle]) -> Vec<Vec3> {
+    bodies
+        .iter()
+        .filter_map(|&h| world.body(h).map(|b| b.position))
         .collect()
 }
 
@@ -530,10 +537,15 @@ pub fn run_case(
     let substeps = setting.world_substeps.max(1);
     let step_dt = setting.dt / substeps as f32;
     let closed = world.bodies().all(|(_, _, b)| !b.is_fixed());
-    let dynamic = world.bodies().filter(|(_, _, b)| !b.is_fixed()).count();
+    let dynamic: Vec<BodyHandle> = world
+        .bodies()
+        .filter(|(_, _, b)| !b.is_fixed())
+        .map(|(h, _, _)| h)
+        .collect();
     let e0 = mechanical_energy(world);
     let mut energy_error = 0.0f64;
-    let mut settled = dynamic_positions(world);
+    let mut settled = positions(world, &dynamic);
+    let mut quarantined = 0usize;
     let mut frame_times = Vec::with_capacity(frames as usize);
     let (mut max_pen, mut pen_sum, mut pen_steps) = (0.0f32, 0.0f64, 0u64);
     let mut asleep_since: Option<u64> = None;
@@ -541,7 +553,7 @@ pub fn run_case(
     for frame in 1..=frames {
         let mut t = Duration::ZERO;
         for _ in 0..substeps {
-            world.step(step_dt)?;
+            quarantined += world.step(step_dt)?.quarantined.len();
             t += world.profile().total;
         }
         frame_times.push(t);
@@ -552,7 +564,7 @@ pub fn run_case(
             energy_error = energy_error.max((mechanical_energy(world) - e0).abs());
         }
         if frame == settle_frame {
-            settled = dynamic_positions(world);
+            settled = positions(world, &dynamic);
         }
         if frame > settle_frame {
             let overlaps = world
@@ -569,7 +581,8 @@ pub fn run_case(
                 pen_steps += 1;
             }
         }
-        let all_asleep = dynamic > 0 && world.profile().awake_bodies == 0;
+        let all_asleep =
+            !dynamic.is_empty() && quarantined == 0 && world.profile().awake_bodies == 0;
         match (all_asleep, asleep_since) {
             (true, None) => asleep_since = Some(frame),
             (false, Some(_)) => asleep_since = None,
@@ -577,11 +590,15 @@ pub fn run_case(
         }
     }
 
-    let drift = dynamic_positions(world)
-        .iter()
-        .zip(&settled)
-        .map(|(p, q)| p.distance(*q))
-        .fold(0.0, f32::max);
+    let drift = if quarantined > 0 {
+        f32::INFINITY
+    } else {
+        positions(world, &dynamic)
+            .iter()
+            .zip(&settled)
+            .map(|(p, q)| p.distance(*q))
+            .fold(0.0, f32::max)
+    };
     let ms_per_step = crate::run::median(&frame_times).as_secs_f64() * 1e3;
     Ok(Metrics {
         frames,
@@ -595,8 +612,11 @@ pub fn run_case(
             0.0
         },
         energy_error: closed.then(|| energy_error / e0.abs().max(1.0)),
-        time_to_sleep: asleep_since.map(|f| f as f64 * dt),
+        time_to_sleep: asleep_since
+            .filter(|_| quarantined == 0)
+            .map(|f| f as f64 * dt),
         analytic_error: tracker.map(|t| t.finish(world, frames as f64 * dt)),
+        quarantined,
     })
 }
 
@@ -619,6 +639,35 @@ mod tests {
             Err(SceneError::Setting { field, message, .. }) => (field, message),
             other => panic!("expected a setting error, got {other:?}"),
         }
+    }
+
+    #[test]
+    fn a_quarantined_body_is_reported_not_counted_as_still_and_asleep() {
+        use crate::{BodyDesc, ShapeDesc, WorldSettings};
+        let mut world = World::new(WorldSettings::default());
+        world
+            .add_body(BodyDesc::fixed(
+                "ground",
+                ShapeDesc::HalfSpace { normal: Vec3::Y },
+            ))
+            .unwrap();
+        let bad = world
+            .add_body(BodyDesc::dynamic("bad", ShapeDesc::Ball { radius: 0.5 }).at(Vec3::Y * 3.0))
+            .unwrap();
+        world
+            .add_body(BodyDesc::dynamic("good", ShapeDesc::Ball { radius: 0.5 }).at(Vec3::X * 5.0))
+            .unwrap();
+        // A finite force whose velocity overflows: the body is quarantined in the first step
+        // (frozen, as a fixed body) while the good ball falls and comes to rest.
+        world.apply_force(bad, Vec3::Y * f32::MAX).unwrap();
+        world.apply_force(bad, Vec3::Y * f32::MAX).unwrap();
+        let setting = default_setting(&world, 1.0 / 60.0);
+        let m = run_case(&mut world, &setting, 4.0, 1.0, None).unwrap();
+        assert_eq!(m.quarantined, 1);
+        // Before: the frozen body left the position lists, the drift compared other bodies'
+        // positions, and the run reported every body asleep.
+        assert!(m.drift.is_infinite(), "{m:?}");
+        assert_eq!(m.time_to_sleep, None);
     }
 
     #[test]

@@ -28,7 +28,7 @@ const DEFAULT_SCENES: [&str; 3] = [
 /// The CSV header of `results.csv`, exactly. Empty fields are metrics that do not apply
 /// (energy error of an open system, time to sleep of a scene that never sleeps, analytic
 /// error of a scene that declares no closed form).
-pub const CSV_HEADER: &str = "scene,resolver,setting,dt,frames,ms_per_step,ms_per_60hz_step,drift_m,max_penetration_m,mean_penetration_m,energy_error,time_to_sleep_s,analytic_error";
+pub const CSV_HEADER: &str = "scene,resolver,setting,dt,frames,ms_per_step,ms_per_60hz_step,drift_m,max_penetration_m,mean_penetration_m,energy_error,time_to_sleep_s,analytic_error,quarantined";
 
 /// Arguments of `jostle bench`.
 #[derive(Args, Debug)]
@@ -210,7 +210,7 @@ fn csv(rows: &[Row]) -> String {
         let m = &r.metrics;
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{:.6},{:.6},{:e},{:e},{:e},{},{},{}",
+            "{},{},{},{},{},{:.6},{:.6},{:e},{:e},{:e},{},{},{},{}",
             r.scene.replace(',', ";"),
             r.resolver,
             r.setting.label,
@@ -224,6 +224,7 @@ fn csv(rows: &[Row]) -> String {
             opt(m.energy_error, |v| format!("{v:e}")),
             opt(m.time_to_sleep, |v| format!("{v:.4}")),
             opt(m.analytic_error, |v| format!("{v:e}")),
+            m.quarantined,
         );
     }
     out
@@ -233,7 +234,7 @@ fn table(rows: &[Row]) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "{:<22} {:<10} {:<14} {:>9} {:>11} {:>10} {:>10} {:>10} {:>10} {:>8} {:>10}",
+        "{:<22} {:<10} {:<14} {:>9} {:>11} {:>10} {:>10} {:>10} {:>10} {:>8} {:>10} {:>5}",
         "scene",
         "resolver",
         "setting",
@@ -244,14 +245,15 @@ fn table(rows: &[Row]) -> String {
         "mean pen m",
         "energy err",
         "sleep s",
-        "analyt err"
+        "analyt err",
+        "quar"
     );
     let dash = |x: Option<f64>, prec: usize| x.map_or("-".to_string(), |v| format!("{v:.prec$}"));
     for r in rows {
         let m = &r.metrics;
         let _ = writeln!(
             out,
-            "{:<22} {:<10} {:<14} {:>9.3} {:>11.3} {:>10.2e} {:>10.2e} {:>10.2e} {:>10} {:>8} {:>10}",
+            "{:<22} {:<10} {:<14} {:>9.3} {:>11.3} {:>10.2e} {:>10.2e} {:>10.2e} {:>10} {:>8} {:>10} {:>5}",
             r.scene,
             r.resolver,
             r.setting.label,
@@ -263,6 +265,7 @@ fn table(rows: &[Row]) -> String {
             m.energy_error.map_or("-".into(), |e| format!("{e:.2e}")),
             dash(m.time_to_sleep, 2),
             m.analytic_error.map_or("-".into(), |e| format!("{e:.2e}")),
+            m.quarantined,
         );
     }
     out
@@ -361,6 +364,16 @@ fn draw<DB: DrawingBackend>(
 ) -> Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plot of {name}: {e}");
     root.fill(&WHITE).map_err(err)?;
+    // A run with a quarantined body has no finite error to draw (its row says so).
+    let rows: Vec<&Row> = rows
+        .iter()
+        .copied()
+        .filter(|r| error_of(&r.metrics, plotted).is_finite())
+        .collect();
+    if rows.is_empty() {
+        return root.present().map_err(err);
+    }
+    let rows = &rows[..];
     // Costs span orders of magnitude between resolvers, so both axes are logarithmic.
     let xs = rows.iter().map(|r| r.metrics.ms_per_60hz_step.max(FLOOR));
     let ys = rows

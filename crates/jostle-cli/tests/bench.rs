@@ -9,7 +9,7 @@ fn temp_dir() -> PathBuf {
     dir
 }
 
-const HEADER: [&str; 13] = [
+const HEADER: [&str; 14] = [
     "scene",
     "resolver",
     "setting",
@@ -23,6 +23,7 @@ const HEADER: [&str; 13] = [
     "energy_error",
     "time_to_sleep_s",
     "analytic_error",
+    "quarantined",
 ];
 
 #[test]
@@ -83,6 +84,7 @@ fn bench_writes_csv_with_finite_metrics_and_both_plots() {
     let col = |name: &str| HEADER.iter().position(|h| *h == name).unwrap();
     for row in &rows {
         assert_eq!(row.len(), HEADER.len(), "{row:?}");
+        assert_eq!(row[col("quarantined")], "0", "{row:?}");
         let (spin, fall) = (row[0] == "tiny spin", row[0] == "tiny fall");
         for (i, field) in row.iter().enumerate().skip(3) {
             // Energy error applies to the closed systems only (no fixed body), time to sleep to
