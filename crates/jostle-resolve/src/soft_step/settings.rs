@@ -93,7 +93,7 @@ pub struct SoftStepSettings {
     /// Gauss-Seidel sweeps over a manifold's normal rows per pass with rigid contacts (count).
     /// Default 8. The points of a face share their load through the bodies' rotation, and
     /// one sweep leaves most of that coupling unsolved: a column of 40 boxes falls with 4
-    /// sweeps and stands with 6.
+    /// sweeps and stands with 8.
     pub normal_sweeps: u32,
 }
 

@@ -485,7 +485,8 @@ pub struct BiasedPass {
     /// Largest push-out speed of the soft bias (m/s).
     pub max_push_out: f32,
     /// Overlap (m) beyond a resting contact's static compression still pushed out through
-    /// real velocity ([`super::SoftStepSettings::push_out_slop`]).
+    /// real velocity ([`super::SoftStepSettings::push_out_slop`]); with `rigid`, the overlap
+    /// left alone ([`super::SoftStepSettings::rigid_slop`]).
     pub slop: f32,
     /// Approach speed (m/s) at the start of the step below which a loaded contact is resting.
     pub resting_speed: f32,
