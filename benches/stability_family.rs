@@ -11,8 +11,9 @@
 //! ms per step, for both engines.
 //!
 //! Run: `cargo bench --bench stability_family` (several minutes; `FAMILY=base` runs only the
-//! base family, `FAMILY=variations` only the variations). With `--test` (`cargo test
-//! --benches`) only a short smoke run is made.
+//! base family, `FAMILY=variations` only the variations; `FAMILY_ONLY` keeps the cases whose
+//! name contains one of its `|`-separated parts, as in `family_table`). With `--test` (`cargo
+//! test --benches`) only a short smoke run is made.
 
 #[path = "../tests/common/family.rs"]
 mod family;
@@ -109,6 +110,8 @@ fn main() {
     if which != "base" {
         cases.extend(family::variations());
     }
+    let only = std::env::var("FAMILY_ONLY").unwrap_or_default();
+    cases.retain(|c| only.split('|').any(|part| c.name.contains(part)));
     let seconds = if smoke { 0.5 } else { 20.0 };
     if smoke {
         cases.truncate(2);

@@ -714,8 +714,8 @@ mod tests {
 
     #[test]
     fn free_fall_error_is_the_integrators_half_g_t_h() {
-        // h is the integration step: dt for Millington, dt / 4 for the soft step's substeps.
-        for (resolver, h) in [("Millington()", 1.0 / 60.0), ("SoftStep()", 1.0 / 240.0)] {
+        // h is the integration step: dt for Millington, dt / 8 for the soft step's substeps.
+        for (resolver, h) in [("Millington()", 1.0 / 60.0), ("SoftStep()", 1.0 / 480.0)] {
             let scene = Scene::parse(
                 &format!(
                     "Scene(analytic: FreeFall(body: \"b\"), resolver: {resolver}, bodies: [Body(name: \"b\", shape: Ball(radius: 0.5), position: (0.0, 10.0, 0.0), can_sleep: false)])"

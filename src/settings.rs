@@ -28,7 +28,7 @@ pub enum ResolverChoice {
 impl Default for ResolverChoice {
     /// The soft-step resolver: the one that measures best on the stability family and the
     /// analytic set (benches/RESULTS.md). Release, 60 Hz, sleep off: the 20-row pyramid costs
-    /// 0.3 ms in its resolve stage and drifts 1.5 mm between 2 s and 10 s, where Millington
+    /// 0.42 ms in its resolve stage and drifts 0.4 mm between 2 s and 20 s, where Millington
     /// costs 44–56 ms and lets it creep 0.21 m; a 10-box column stays up (Millington's falls);
     /// overlapping starts are separated without kinetic energy (split impulses). Millington
     /// stays one setting away: `ResolverChoice::Millington(Default::default())`, `resolver:

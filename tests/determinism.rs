@@ -113,7 +113,7 @@ fn a_snapshot_with_invalid_settings_is_refused_by_name() {
     std::fs::remove_file(&path).ok();
     assert!(World::from_snapshot(Snapshot::parse(&text, "good").unwrap()).is_ok());
     let edits = [
-        ("substeps: 4", "substeps: 0", "settings.resolver.substeps"),
+        ("substeps: 8", "substeps: 0", "settings.resolver.substeps"),
         (
             "prediction: 0.02",
             "prediction: -1.0",
