@@ -159,6 +159,19 @@ impl Outcome {
     }
 }
 
+impl std::fmt::Display for Outcome {
+    /// The criterion's figures, for assertion messages.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "drift {:.2} mm, sink {:.3} mm per layer, {} bodies moved",
+            self.drift * 1e3,
+            self.sink_per_layer * 1e3,
+            self.moved
+        )
+    }
+}
+
 impl Outcome {
     /// The outcome as the cells of a markdown table row: drift, sink per layer, penetration
     /// (mm), bodies moved, ms/step, and whether it meets the criterion.
