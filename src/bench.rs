@@ -612,9 +612,8 @@ pub fn run_case(
             0.0
         },
         energy_error: closed.then(|| energy_error / e0.abs().max(1.0)),
-        time_to_sleep: asleep_since
-            .filter(|_| quarantined == 0)
-            .map(|f| f as f64 * dt),
+        // `all_asleep` is false from the frame of a quarantine on, so a run with one has none.
+        time_to_sleep: asleep_since.map(|f| f as f64 * dt),
         analytic_error: tracker.map(|t| t.finish(world, frames as f64 * dt)),
         quarantined,
     })
