@@ -122,6 +122,7 @@ pub(crate) fn gather(
             .with_restitution(c.restitution);
         contact.impulse = c.impulse;
         contact.point_b = c.point_b;
+        contact.preload = c.preload;
         scratch.contacts.push(contact);
         scratch.contact_source.push(i as u32);
     }
@@ -304,7 +305,7 @@ pub(crate) fn scatter(
     }
     // Contacts the resolver did not see (between two fixed or sleeping bodies) keep theirs.
     for (contact, &source) in scratch.contacts.iter().zip(&scratch.contact_source) {
-        narrow.store_impulse(source as usize, contact.impulse);
+        narrow.store_point(source as usize, contact.impulse, contact.preload);
     }
 }
 

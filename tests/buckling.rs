@@ -30,6 +30,9 @@ fn soft(substeps: u32, contact_hertz: f32, static_hertz: f32) -> SoftStepSetting
         substeps,
         contact_hertz,
         static_hertz,
+        // The model's contacts are plain springs; load compensation stiffens a loaded spring
+        // near its rest overlap, which the model does not describe.
+        preload_rate: 0.0,
         ..SoftStepSettings::default()
     }
 }

@@ -10,9 +10,8 @@
 //! run side by side with rapier3d in `cargo bench --bench stability_family`. The Millington
 //! resolver meets the criterion on none of the family (a 10-box column falls); the cases below
 //! run the engine's default, the soft step at its defaults: those that meet the criterion are
-//! tests of their own (and columns that stand but sink more than the criterion allows are
-//! tested to stand), the others are listed with their figures in benches/RESULTS.md ("Eight
-//! substeps by default") until a resolver meets them.
+//! tests of their own, the others are listed with their figures in benches/RESULTS.md ("Load
+//! compensation") until a resolver meets them.
 
 mod common;
 
@@ -68,40 +67,55 @@ fn a_planar_pyramid_of_small_boxes_stands() {
     assert_stands(&family::pyramid(20, v), 20.0);
 }
 
-/// Soft contacts still sink in proportion to their load (1.3 mm per layer for the 20-column,
-/// 2.7 for the 40-column at the defaults), so these columns do not meet the sink criterion; what
-/// they must do is stand: no box leaves its place and none drifts a centimetre.
-fn assert_column_stands_sinking(case: &Case) {
-    let o = family::run(case, 20.0, soft_step());
-    assert!(
-        o.moved == 0 && o.drift < family::MAX_DRIFT,
-        "{}: {o}",
-        case.name
-    );
-}
-
 #[test]
 fn a_column_of_40_stands() {
-    // 4 substeps at 30 Hz: the column falls.
-    assert_column_stands_sinking(&family::column(40, Variant::default()));
+    // Without load compensation (`preload_rate: 0`) it stands but sinks 2.7 mm per layer; at 4
+    // substeps and 30 Hz it falls.
+    assert_stands(&family::column(40, Variant::default()), 20.0);
 }
 
 #[test]
 fn perturbed_columns_of_20_stand() {
-    // 4 substeps at 30 Hz: both fall.
+    // Without load compensation: 1.3 mm of sink per layer; at 4 substeps and 30 Hz both fall.
     for seed in [1, 2] {
         let v = Variant {
             seed: Some(seed),
             ..Variant::default()
         };
-        assert_column_stands_sinking(&family::column(20, v));
+        assert_stands(&family::column(20, v), 20.0);
     }
+}
+
+#[test]
+fn a_light_box_under_a_100_times_heavier_one_stands() {
+    // Without load compensation: 4.4 mm of sink per layer. (The 5-box column under the same box
+    // sinks 1.3 mm per layer with it, 10 mm without; the preload's stiffening is bounded there.)
+    assert_stands(&family::heavy_on_light(100.0, 2, Variant::default()), 20.0);
+}
+
+#[test]
+fn load_compensation_removes_the_load_proportional_sink() {
+    // The same column with the preload off sinks by its springs' compression under the load.
+    let case = family::column(20, Variant::default());
+    let off = Some(ResolverChoice::SoftStep(SoftStepSettings {
+        preload_rate: 0.0,
+        ..SoftStepSettings::default()
+    }));
+    let without = family::run(&case, 10.0, off);
+    let with = family::run(&case, 10.0, soft_step());
+    assert!(
+        without.sink_per_layer > family::MAX_SINK_PER_LAYER,
+        "{without}"
+    );
+    assert!(with.sink_per_layer < family::MAX_SINK_PER_LAYER, "{with}");
+    assert!(with.moved == 0 && with.drift < family::MAX_DRIFT, "{with}");
 }
 
 /// The whole family's figures at the defaults, as a markdown table (a measurement: asserts
 /// only that every run stays finite). `FAMILY_RESOLVER` names the resolver (see the module
 /// docs) or gives it in RON (`SoftStep((substeps: 8))`); `FAMILY_ONLY` keeps the cases whose
-/// name contains one of its `|`-separated parts (`column 20|pyramid 40`).
+/// name contains one of its `|`-separated parts (`column 20|pyramid 40`); `FAMILY_SECONDS`
+/// sets the simulated time (default 20; the long runs use 60).
 #[test]
 #[ignore = "a measurement of several minutes in release; run with --ignored --nocapture"]
 fn family_table() {
@@ -115,13 +129,16 @@ fn family_table() {
         Err(_) => soft_step(),
     };
     let only = std::env::var("FAMILY_ONLY").unwrap_or_default();
+    let seconds: f32 = std::env::var("FAMILY_SECONDS")
+        .map(|s| s.parse().expect("FAMILY_SECONDS: seconds"))
+        .unwrap_or(20.0);
     println!(
-        "| case | lateral drift 2–20 s (mm) | sink per layer (mm) | largest penetration (mm) | bodies moved | ms/step | meets the criterion |"
+        "| case | lateral drift 2–{seconds} s (mm) | sink per layer (mm) | largest penetration (mm) | bodies moved | ms/step | meets the criterion |"
     );
     println!("|---|---:|---:|---:|---:|---:|---|");
     let cases = family::base().into_iter().chain(family::variations());
     for case in cases.filter(|c| only.split('|').any(|part| c.name.contains(part))) {
-        let o = family::run(&case, 20.0, resolver.clone());
+        let o = family::run(&case, seconds, resolver.clone());
         assert!(o.drift.is_finite() && o.sink_per_layer.is_finite());
         println!("| {} | {} |", case.name, o.cells());
     }

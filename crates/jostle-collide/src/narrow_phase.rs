@@ -53,6 +53,10 @@ pub struct BodyContact {
     /// The resolver's accumulated impulse of the last step for this point, in contact space
     /// (x along the normal), for warm starting; zero for a new point.
     pub impulse: Vec3,
+    /// The compression (m) the resolver's soft spring at this point took as already carried
+    /// at the end of the last step (the soft step's load compensation), carried like the
+    /// impulse; zero for a new point.
+    pub preload: f32,
 }
 
 /// Two bodies started or stopped touching (some contact point with penetration ≥ 0) during an
@@ -85,6 +89,9 @@ pub struct NarrowStats {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct PointData {
     impulse: Vec3,
+    /// The resolver's preload of the point ([`BodyContact::preload`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    preload: f32,
     /// The point's held contact frame ([`CollideSettings::frame_tolerance`]); `None` until
     /// first taken, or with the tolerance 0.
     #[cfg_attr(feature = "serde", serde(default))]
@@ -250,24 +257,45 @@ impl NarrowPhase {
     /// a caller's bug: ignored in release builds, a failed debug assertion otherwise.
     #[inline]
     pub fn store_impulse(&mut self, index: usize, impulse: Vec3) {
+        if let Some((contact, point)) = self.point_mut(index) {
+            contact.impulse = impulse;
+            if let Some(point) = point {
+                point.impulse = impulse;
+            }
+        }
+    }
+
+    /// Writes the resolver's impulse and preload ([`BodyContact::preload`]) for contact
+    /// `index` back into its persistent point, as [`NarrowPhase::store_impulse`].
+    #[inline]
+    pub fn store_point(&mut self, index: usize, impulse: Vec3, preload: f32) {
+        if let Some((contact, point)) = self.point_mut(index) {
+            contact.impulse = impulse;
+            contact.preload = preload;
+            if let Some(point) = point {
+                point.impulse = impulse;
+                point.preload = preload;
+            }
+        }
+    }
+
+    /// Contact `index` and its persistent point's data (`None` for the data if its manifold
+    /// is gone); `None` with a failed debug assertion for an index past the contacts.
+    #[inline]
+    fn point_mut(&mut self, index: usize) -> Option<(&mut BodyContact, Option<&mut PointData>)> {
+        let n = self.contacts.len();
         let (Some(slot), Some(contact)) = (self.slots.get(index), self.contacts.get_mut(index))
         else {
-            debug_assert!(
-                false,
-                "impulse for contact {index} of {}",
-                self.contacts.len()
-            );
-            return;
+            debug_assert!(false, "impulse for contact {index} of {n}");
+            return None;
         };
-        contact.impulse = impulse;
         let point = self
             .pairs
             .get_mut(slot.pair as usize)
             .and_then(|p| p.manifolds.get_mut(slot.manifold as usize))
-            .and_then(|m| m.points.get_mut(slot.point as usize));
-        if let Some(point) = point {
-            point.data.impulse = impulse;
-        }
+            .and_then(|m| m.points.get_mut(slot.point as usize))
+            .map(|p| &mut p.data);
+        Some((contact, point))
     }
 
     /// Updates the manifolds of `pairs` (as the broad phase gives them: sorted, unique; other
@@ -379,6 +407,7 @@ impl NarrowPhase {
                         friction: material.friction,
                         restitution: material.restitution,
                         impulse: pt.data.impulse,
+                        preload: pt.data.preload,
                     });
                     self.slots.push(PointSlot {
                         pair: pair_index,

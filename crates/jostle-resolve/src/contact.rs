@@ -39,9 +39,16 @@ pub struct Contact {
     pub b: u32,
     /// World-space point where the contact acts on B (m).
     pub point_b: Vec3,
+    /// The compression (m) the soft step's spring at this point takes as already carried:
+    /// learned over the steps from the overlap the point keeps under its load
+    /// ([`crate::soft_step::SoftStepSettings::preload_rate`]), so that a loaded contact
+    /// rests near [`crate::soft_step::SoftStepSettings::preload_target`] instead of at its
+    /// spring's compression. Carried across steps with the impulse; 0 for a new point; the
+    /// Millington resolver neither reads nor changes it.
+    pub preload: f32,
 }
 
-const _: () = assert!(size_of::<Contact>() <= 68);
+const _: () = assert!(size_of::<Contact>() <= 72);
 
 impl Contact {
     /// A contact with no stored impulse.
@@ -56,6 +63,7 @@ impl Contact {
             a,
             b,
             point_b: point,
+            preload: 0.0,
         }
     }
 

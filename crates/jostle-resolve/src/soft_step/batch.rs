@@ -86,10 +86,15 @@ pub struct PointLanes<F = F8> {
     pub restitution: F,
     /// Normal relative velocity at the start of the step (m/s).
     pub relative_velocity: F,
+    /// The compression the spring takes as already carried ([`crate::Contact::preload`], m).
+    pub preload: F,
+    /// How fast the preload grows in with the overlap (dimensionless): the spring is
+    /// compressed by min(preload, slope · overlap) more ([`super::prepare::prepare_point`]).
+    pub preload_slope: F,
 }
 
-// 192 bytes per contact point: 11 vectors and 15 scalars, each eight lanes wide.
-const _: () = assert!(size_of::<PointLanes>() <= 192 * LANES);
+// 200 bytes per contact point: 11 vectors and 17 scalars, each eight lanes wide.
+const _: () = assert!(size_of::<PointLanes>() <= 200 * LANES);
 
 /// Eight manifolds (one per lane) with disjoint non-static bodies; their points are
 /// `points[first .. first + count]` of the [`Batches`].
@@ -342,6 +347,8 @@ mod tests {
             static_softness: s,
             dynamic_softness: s,
             warm_scale: 0.25,
+            preload_ramp: 0.0,
+            preload_bound: 0.0,
         }
     }
 

@@ -28,6 +28,13 @@ pub struct PrepareParams {
     pub dynamic_softness: Softness,
     /// Scale from the stored step impulse to one substep's warm start (1/substeps, or 0).
     pub warm_scale: f32,
+    /// 1 / [`super::SoftStepSettings::preload_target`] (1/m; `f32::MAX` for a target of 0):
+    /// a point's preload grows in over that much overlap.
+    pub preload_ramp: f32,
+    /// (ζ / [`super::PRELOAD_MIN_DAMPING`])²·|g|·h (m/s), ζ the damping ratio: bounds how
+    /// much the preload may stiffen a point under its load ([`prepare_point`]); 0 turns the
+    /// preload off.
+    pub preload_bound: f32,
 }
 
 /// The step-start state of eight bodies, by lane, as preparation reads it.
@@ -99,6 +106,7 @@ pub fn prepare_point<F: Lane>(
     let mut penetration = [0.0; WIDTH];
     let mut friction = [0.0; WIDTH];
     let mut restitution = [0.0; WIDTH];
+    let mut preload = [0.0; WIDTH];
     for (lane, c) in contacts.iter().enumerate() {
         if let Some(c) = c {
             vectors[0][lane] = c.normal;
@@ -109,6 +117,7 @@ pub fn prepare_point<F: Lane>(
             penetration[lane] = c.penetration;
             friction[lane] = c.friction;
             restitution[lane] = c.restitution;
+            preload[lane] = c.preload;
         }
     }
     // No closures over lanes here or below: a closure is not compiled with the target
@@ -163,6 +172,18 @@ pub fn prepare_point<F: Lane>(
     let warm = stored * F::splat(params.warm_scale);
     let has_friction = friction.cmpgt(F::ZERO);
     let dv = a.velocity_at(r_a) - b.velocity_at(r_b);
+    // The preload acts in proportion to the overlap up to its full value, reached at the
+    // target overlap: slope p / target. The spring is then 1 + slope times stiffer there, and
+    // the load λ it carries rides on it like a mass of λ/(|g|·h); its damping ratio falls as
+    // ζ·√(m / (mass · (1 + slope))), so the slope is bounded to keep it at
+    // PRELOAD_MIN_DAMPING or more: 1 + slope ≤ (ζ / PRELOAD_MIN_DAMPING)²·m·|g|·h / λ.
+    let preload = F::from_array(preload).max(F::ZERO);
+    let loaded = warm.x.cmpgt(F::ZERO);
+    let bound =
+        F::splat(params.preload_bound) * normal_mass / F::select(loaded, warm.x, F::ONE) - F::ONE;
+    let slope = preload * F::splat(params.preload_ramp);
+    let slope = F::select(slope.cmpgt(bound), bound, slope).max(F::ZERO);
+    let preload_slope = F::select(loaded, slope, F::ZERO);
     *out = PointLanes {
         normal: n,
         r_a,
@@ -190,6 +211,8 @@ pub fn prepare_point<F: Lane>(
         ],
         restitution: F::from_array(restitution),
         relative_velocity: dv.dot(n),
+        preload,
+        preload_slope,
     };
 }
 
@@ -264,6 +287,8 @@ mod tests {
             static_softness: Softness::new(60.0, 10.0, h),
             dynamic_softness: Softness::new(30.0, 10.0, h),
             warm_scale: 0.25,
+            preload_ramp: 0.0,
+            preload_bound: 0.0,
         };
         let mut batches = Batches::default();
         batches.pack(&scene.contacts, &scene.bodies, 0.02, &params);
@@ -317,6 +342,8 @@ mod tests {
             static_softness: Softness::new(60.0, 10.0, 0.01),
             dynamic_softness: Softness::new(30.0, 10.0, 0.01),
             warm_scale: 0.25,
+            preload_ramp: 0.0,
+            preload_bound: 0.0,
         };
         for _ in 0..50 {
             let contacts: Vec<Contact> = (0..WIDTH - 1)

@@ -5,7 +5,8 @@
 //! substeps at 30 Hz (60 Hz against static bodies) doubled to 8 substeps at 60 Hz (120 Hz): the
 //! same stiffness relative to the substep rate, a quarter of the load-proportional sink, and the
 //! stability family of the `jostle` crate's tests standing where 4 substeps let columns fall
-//! (its benches/RESULTS.md, "Eight substeps by default").
+//! (its benches/RESULTS.md, "Eight substeps by default"); load compensation (`preload_rate`)
+//! then removes most of the remaining sink (RESULTS.md, "Load compensation").
 
 /// Settings of [`crate::soft_step::SoftStepResolver`].
 #[derive(Clone, Debug, PartialEq)]
@@ -82,10 +83,10 @@ pub struct SoftStepSettings {
     pub warm_start: bool,
     /// Rigid contacts instead of springs. Default false.
     ///
-    /// Soft contacts (`contact_hertz`, `static_hertz`) are springs: they sink in proportion to
-    /// the load they carry (a column of 40 unit boxes sinks 0.11 m at the defaults, 0.43 m at
-    /// 4 substeps and 30 Hz as in rapier3d) and a tall column of them buckles like an elastic
-    /// one. Rigid contacts have no spring: the biased
+    /// Soft contacts (`contact_hertz`, `static_hertz`) are springs: without load compensation
+    /// (`preload_rate`) they sink in proportion to the load they carry (a column of 40 unit
+    /// boxes sinks 0.11 m at 8 substeps, 0.43 m at 4 substeps and 30 Hz as in rapier3d; with
+    /// it, as by default, 19 mm) and a tall column of them buckles like an elastic one. Rigid contacts have no spring: the biased
     /// pass is the relax pass's rigid row (friction included), and every overlap beyond
     /// `rigid_slop` is pushed out through pseudo velocities at `push_out_rate`, so the sink is
     /// bounded by the slop whatever the load. Measured on the stability family (the `jostle`
@@ -105,6 +106,32 @@ pub struct SoftStepSettings {
     /// one sweep leaves most of that coupling unsolved: a column of 40 boxes falls with 4
     /// sweeps and stands with 8.
     pub normal_sweeps: u32,
+    /// Load compensation of soft contacts (fraction per step, in [0, 1]). Default 0.02; 0
+    /// turns it off.
+    ///
+    /// A soft contact settles at its spring's compression under its load, so without it a
+    /// column's sink grows with the weight it carries (1.3 mm per layer for 20 unit boxes,
+    /// 4.1 mm for 60, 43 mm under a box 1,000 times heavier). With a rate r > 0 every loaded
+    /// manifold learns a preload ([`crate::Contact::preload`]), one value for all its points:
+    /// at the end of each step in which it is at rest, r times its mean overlap beyond
+    /// `preload_target` is added to it (a shortfall takes it down; never below 0, never above
+    /// its springs' static compression under their load), and each of its points' springs
+    /// acts as if compressed by that much more, growing in over the first `preload_target` of
+    /// overlap. A loaded manifold then rests near `preload_target` whatever its load, after a
+    /// few seconds. How much the preload may stiffen a spring is bounded by the load it
+    /// carries, so that the load riding on it keeps a damping ratio of at least
+    /// [`super::PRELOAD_MIN_DAMPING`]: under very heavy loads (1,000 times the supporting
+    /// body's mass) it removes only part of the sink. It needs gravity (its bound is stated in
+    /// |g|) and does nothing with `rigid_contacts`.
+    ///
+    /// Measured on the stability family (the `jostle` crate's benches/RESULTS.md, "Load
+    /// compensation"): columns of 10 to 60 boxes, pyramids of 20 to 60 rows, walls and a light
+    /// box under 100 times its mass sink 0.3–0.8 mm per layer (without: up to 4.4 mm); at 0.05
+    /// a 60-box column falls.
+    pub preload_rate: f32,
+    /// Overlap (m) at which load compensation (`preload_rate`) holds a loaded contact.
+    /// Default 0.0005.
+    pub preload_target: f32,
 }
 
 impl Default for SoftStepSettings {
@@ -127,6 +154,8 @@ impl Default for SoftStepSettings {
             rigid_slop: 0.001,
             push_out_rate: 0.2,
             normal_sweeps: 8,
+            preload_rate: 0.02,
+            preload_target: 0.0005,
         }
     }
 }
@@ -170,6 +199,13 @@ impl SoftStepSettings {
                 format!("must be in (0, 1], got {}", self.push_out_rate),
             ));
         }
+        if !(self.preload_rate >= 0.0 && self.preload_rate <= 1.0) {
+            return Err((
+                "preload_rate",
+                format!("must be in [0, 1], got {}", self.preload_rate),
+            ));
+        }
+        non_negative("preload_target", self.preload_target)?;
         if self.normal_sweeps == 0 {
             return Err(("normal_sweeps", "must be >= 1, got 0".into()));
         }
@@ -209,5 +245,15 @@ mod tests {
             ..Default::default()
         };
         assert_eq!(bad.validate().unwrap_err().0, "normal_sweeps");
+        let bad = SoftStepSettings {
+            preload_rate: 1.5,
+            ..Default::default()
+        };
+        assert_eq!(bad.validate().unwrap_err().0, "preload_rate");
+        let bad = SoftStepSettings {
+            preload_target: f32::NAN,
+            ..Default::default()
+        };
+        assert_eq!(bad.validate().unwrap_err().0, "preload_target");
     }
 }

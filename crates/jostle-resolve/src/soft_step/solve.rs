@@ -617,8 +617,14 @@ fn solve_batch_split<F: Lane>(
         let speculative = s.cmpgt(F::ZERO);
         let soft_mass = p.normal_mass * p.mass_scale;
         let bleed = p.impulse_scale * p.normal_impulse;
-        // The bias as an impulse (≤ 0 on overlap), and the part of it the load explains.
-        let bias = soft_mass * (p.bias_rate * s).max(push_out);
+        // The bias as an impulse (≤ 0 on overlap), with the spring compressed by its preload
+        // too (in proportion to the overlap up to the full preload: a preload that set in at
+        // first touch would pump the bounces of a rocking box), and the part of it the load
+        // explains.
+        let extra = (-s * p.preload_slope).max(F::ZERO);
+        let extra = F::select(extra.cmpgt(p.preload), p.preload, extra);
+        let spring = F::select(speculative, s, s - extra);
+        let bias = soft_mass * (p.bias_rate * spring).max(push_out);
         let resting = p.normal_impulse.cmpgt(F::ZERO) & resting_speed.cmplt(p.relative_velocity);
         let allowance = F::select(resting, p.bias_rate * slop + gravity_speed, F::ZERO);
         let vn = pair.relative_velocity(p).dot(p.normal);
@@ -885,19 +891,67 @@ pub fn restitution_response(batches: &Batches, inv_inertia_now: &[Mat3], out: &m
     }
 }
 
-/// Calls `f` for every contact packed in `batches` with its input index, its accumulated
-/// impulse of the substep in contact space (normal, t₁, t₂) in N·s, and its separation now
-/// in m.
+/// A manifold's state at the end of the step, as [`results`] gives it with each of its points:
+/// the mean over its points of their overlap (−separation, m) and of their preload
+/// ([`crate::Contact::preload`], m), its total normal impulse per substep (N·s), and the
+/// fastest normal relative speed of its points at the start of the step (m/s).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ManifoldEnd {
+    /// Mean overlap of the manifold's points (m; negative for a mean gap).
+    pub penetration: f32,
+    /// Mean preload of the manifold's points (m).
+    pub preload: f32,
+    /// Sum of the points' accumulated normal impulses (N·s, per substep).
+    pub normal_impulse: f32,
+    /// Largest |normal relative velocity| of its points at the start of the step (m/s).
+    pub speed: f32,
+    /// Mean static compression of its points' springs under their accumulated impulses
+    /// (m): s_i·λ / (m·s_m·β), where the bias balances the bleed.
+    pub compression: f32,
+}
+
+/// Calls `f(source, impulse, separation, manifold)` for every prepared contact point: its index
+/// in the contacts given to the step, its accumulated impulse in contact space (per substep),
+/// its separation at the end of the step (m) and its manifold's [`ManifoldEnd`].
 pub fn results(
     batches: &Batches,
     states: &[BodyState],
-    mut f: impl FnMut(u32, jostle_math::Vec3, f32),
+    mut f: impl FnMut(u32, jostle_math::Vec3, f32, ManifoldEnd),
 ) {
+    let mut separations = [F8::ZERO; MAX_POINTS];
     for m in &batches.manifolds {
         let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
-        for i in m.first as usize..(m.first + m.count) as usize {
+        let range = m.first as usize..(m.first + m.count) as usize;
+        let mut ends = [ManifoldEnd::default(); LANES];
+        let mut counts = [0u32; LANES];
+        for (k, i) in range.clone().enumerate() {
             let p = &batches.points[i];
-            let s = separation(p, &motion_a, &motion_b);
+            separations[k] = separation(p, &motion_a, &motion_b);
+            for (lane, &source) in batches.sources[i].iter().enumerate() {
+                if source != super::batch::NO_SOURCE {
+                    let end = &mut ends[lane];
+                    end.penetration -= separations[k][lane];
+                    end.preload += p.preload[lane];
+                    end.normal_impulse += p.normal_impulse[lane];
+                    end.speed = end.speed.max(p.relative_velocity[lane].abs());
+                    let stiffness = p.normal_mass[lane] * p.mass_scale[lane] * p.bias_rate[lane];
+                    if stiffness > 0.0 {
+                        end.compression +=
+                            p.impulse_scale[lane] * p.normal_impulse[lane] / stiffness;
+                    }
+                    counts[lane] += 1;
+                }
+            }
+        }
+        for (end, &n) in ends.iter_mut().zip(&counts) {
+            if n > 0 {
+                end.penetration /= n as f32;
+                end.preload /= n as f32;
+                end.compression /= n as f32;
+            }
+        }
+        for (k, i) in range.enumerate() {
+            let p = &batches.points[i];
             for (lane, &source) in batches.sources[i].iter().enumerate() {
                 if source != super::batch::NO_SOURCE {
                     let impulse = jostle_math::Vec3::new(
@@ -905,7 +959,7 @@ pub fn results(
                         p.tangent_impulse[0][lane],
                         p.tangent_impulse[1][lane],
                     );
-                    f(source, impulse, s[lane]);
+                    f(source, impulse, separations[k][lane], ends[lane]);
                 }
             }
         }
@@ -927,9 +981,18 @@ mod tests {
             static_softness: Softness::new(60.0, 10.0, h),
             dynamic_softness: s,
             warm_scale: 0.25,
+            preload_ramp: 2000.0,
+            preload_bound: 1600.0 * 9.81 * h,
         };
         let mut batches = Batches::default();
-        batches.pack(&scene.contacts, &scene.bodies, 0.02, &params);
+        // Preloads on every contact, so the kernels' preload path is exercised too.
+        let contacts: Vec<_> = (scene.contacts.iter().enumerate())
+            .map(|(i, c)| crate::Contact {
+                preload: 0.001 * (i % 3) as f32,
+                ..*c
+            })
+            .collect();
+        batches.pack(&contacts, &scene.bodies, 0.02, &params);
         let mut states: Vec<BodyState> = scene.bodies.iter().map(BodyState::from_body).collect();
         states[0] = BodyState::STATIC;
         for s in states.iter_mut().skip(1) {
