@@ -264,3 +264,17 @@ fn resolver_settings_load_from_the_scene() {
     assert!(e.to_string().contains("velocity_iteration"), "{e}");
     assert!(Scene::parse("Scene(resolver: Cyclone())", "r.ron").is_err());
 }
+
+#[test]
+fn generators_that_would_exhaust_memory_are_errors() {
+    // Each count is in range, but together they make 10¹⁵ boxes.
+    let e = error("Scene(generators: [Piles(nx: 100000, nz: 100000, height: 100000)])");
+    let text = e.to_string();
+    assert!(
+        text.contains("generators[0].count") && text.contains("1000000000000000 bodies"),
+        "{e}"
+    );
+    // A 100,000-row pyramid is 5·10⁹ boxes; 1,000 rows (500,500) is fine.
+    assert!(Scene::parse("Scene(generators: [Pyramid(rows: 100000)])", "p.ron").is_err());
+    assert!(Scene::parse("Scene(generators: [Pyramid(rows: 1000)])", "p.ron").is_ok());
+}

@@ -166,8 +166,51 @@ fn cuboid(name: String, h: Vec3, centre: Vec3, friction: f32, density: f32) -> B
 }
 
 impl Generator {
-    /// Checks the parameters; the error is (field, message).
+    /// The most bodies one generator may make: beyond it a scene would exhaust memory (the
+    /// generators' counts multiply: `Piles(nx: 100000, nz: 100000, height: 100000)` is 10¹⁵
+    /// boxes) before its first step.
+    pub const MAX_BODIES: u64 = 1_000_000;
+
+    /// How many bodies [`Generator::bodies`] makes (for `Wall`, at most this many: a running
+    /// bond's rows alternate between `columns` bricks and `columns − 1` plus two halves).
+    pub fn body_count(&self) -> u64 {
+        match self {
+            Self::Pyramid { rows, .. } => {
+                let r = u64::from(*rows);
+                r * (r + 1) / 2
+            }
+            Self::Pyramid3D { layers, .. } => {
+                let l = u64::from(*layers);
+                l * (l + 1) * (2 * l + 1) / 6
+            }
+            Self::Stack { count, .. } => u64::from(*count),
+            Self::Wall { columns, rows, .. } => {
+                u64::from(*rows).saturating_mul(u64::from(*columns) + 1)
+            }
+            Self::Piles { nx, nz, height, .. } => u64::from(*nx)
+                .saturating_mul(u64::from(*nz))
+                .saturating_mul(u64::from(*height)),
+        }
+    }
+
+    /// Checks the parameters, and that the generator makes at most [`Generator::MAX_BODIES`]
+    /// bodies; the error is (field, message).
     pub fn validate(&self) -> Result<(), (String, String)> {
+        self.validate_parameters()?;
+        let n = self.body_count();
+        if n > Self::MAX_BODIES {
+            return Err((
+                "count".into(),
+                format!(
+                    "makes {n} bodies, more than the {} one generator may make",
+                    Self::MAX_BODIES
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn validate_parameters(&self) -> Result<(), (String, String)> {
         let positive = |field: &str, x: f32| {
             if x.is_finite() && x > 0.0 {
                 Ok(())

@@ -289,7 +289,8 @@ impl SoftStepResolver {
                 f32::MAX
             },
             preload_bound: if s.preload_rate > 0.0 && !s.rigid_contacts {
-                (s.damping_ratio / PRELOAD_MIN_DAMPING).powi(2) * gravity * h
+                // Finite for any settings, so that padding lanes (zero mass) stay at 0.
+                ((s.damping_ratio / PRELOAD_MIN_DAMPING).powi(2) * gravity * h).min(f32::MAX)
             } else {
                 0.0
             },

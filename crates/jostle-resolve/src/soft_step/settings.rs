@@ -37,7 +37,8 @@ pub struct SoftStepSettings {
     /// `contact_hertz`, as Box2D: a static body cannot share the correction). Same cap.
     pub static_hertz: f32,
     /// Damping ratio ζ of the contact spring (dimensionless). Default 10: heavily
-    /// over-damped, so overlap is removed without oscillation.
+    /// over-damped, so overlap is removed without oscillation. At most
+    /// [`SoftStepSettings::MAX_DAMPING_RATIO`].
     pub damping_ratio: f32,
     /// Largest speed at which the soft bias pushes overlapping bodies apart (m/s). Default 3.
     /// Bounds the energy a deep overlap can inject.
@@ -161,6 +162,12 @@ impl Default for SoftStepSettings {
 }
 
 impl SoftStepSettings {
+    /// The largest accepted `damping_ratio`. The spring's bias rate is ω/(2ζ + hω): at
+    /// ζ = 1,000 about a hundredth of the default's (overlap is pushed out about 100 times
+    /// slower than at ζ = 10); larger values only approach a contact that never removes
+    /// overlap.
+    pub const MAX_DAMPING_RATIO: f32 = 1000.0;
+
     /// Normal velocity correction (m/s) below which a restitution sweep counts as converged.
     pub const RESTITUTION_TOLERANCE: f32 = 1e-5;
 
@@ -189,6 +196,16 @@ impl SoftStepSettings {
         positive("contact_hertz", self.contact_hertz)?;
         positive("static_hertz", self.static_hertz)?;
         non_negative("damping_ratio", self.damping_ratio)?;
+        if self.damping_ratio > Self::MAX_DAMPING_RATIO {
+            return Err((
+                "damping_ratio",
+                format!(
+                    "must be <= {}, got {}",
+                    Self::MAX_DAMPING_RATIO,
+                    self.damping_ratio
+                ),
+            ));
+        }
         non_negative("max_push_out", self.max_push_out)?;
         non_negative("push_out_slop", self.push_out_slop)?;
         non_negative("speculative_margin", self.speculative_margin)?;
@@ -255,5 +272,10 @@ mod tests {
             ..Default::default()
         };
         assert_eq!(bad.validate().unwrap_err().0, "preload_target");
+        let bad = SoftStepSettings {
+            damping_ratio: 1e30,
+            ..Default::default()
+        };
+        assert_eq!(bad.validate().unwrap_err().0, "damping_ratio");
     }
 }
