@@ -243,6 +243,10 @@ mod file {
             world.names = snapshot.names;
             world.narrow = snapshot.narrow;
             world.narrow.rebind_shapes(&world.colliders);
+            snapshot
+                .islands
+                .check(world.bodies.capacity_index())
+                .map_err(|e| invalid(format!("islands: {e}")))?;
             world.islands = snapshot.islands;
             if !(snapshot.time.is_finite() && snapshot.time >= 0.0) {
                 return Err(invalid(format!(

@@ -138,3 +138,29 @@ fn a_snapshot_with_invalid_settings_is_refused_by_name() {
         assert!(err.contains(field), "`{to}`: {err}");
     }
 }
+
+/// A snapshot whose sleeping islands were edited into references that do not exist is
+/// refused with what is wrong, instead of panicking on an index when a body wakes (issue 16:
+/// `crates/jostle-sleep/src/islands.rs` indexed the island list unchecked).
+#[test]
+fn a_snapshot_with_broken_islands_is_refused() {
+    let s = scene("pyramid20.ron");
+    let mut world = s.build().unwrap();
+    for _ in 0..100 {
+        world.step(DT).unwrap();
+    }
+    let path = std::env::temp_dir().join(format!("jostle-islands-snapshot-{}", std::process::id()));
+    world.snapshot(&s.name, DT).save(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::remove_file(&path).ok();
+    let at = text.find("sleeping_of: [").expect("an islands section");
+    let (head, tail) = text.split_at(at);
+    assert!(tail.contains("Some(0)"), "nothing asleep after 100 steps");
+    let bad = format!("{head}{}", tail.replacen("Some(0)", "Some(7)", 1));
+    let err = match World::from_snapshot(Snapshot::parse(&bad, "bad").unwrap()) {
+        Ok(_) => panic!("a snapshot naming a missing island was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(err.contains("islands") && err.contains("island 7"), "{err}");
+    assert!(World::from_snapshot(Snapshot::parse(&text, "good").unwrap()).is_ok());
+}

@@ -89,13 +89,15 @@ impl IslandSet {
             .get(handle.index() as usize)
             .copied()
             .flatten();
-        match island.and_then(|i| self.sleeping[i as usize].take()) {
+        match island.and_then(|i| self.sleeping.get_mut(i as usize).and_then(Option::take)) {
             Some(members) => {
                 for m in members {
                     if let Some(b) = bodies.get_mut(m) {
                         motion::wake(b, settings);
                     }
-                    self.sleeping_of[m.index() as usize] = None;
+                    if let Some(slot) = self.sleeping_of.get_mut(m.index() as usize) {
+                        *slot = None;
+                    }
                 }
             }
             None => motion::wake(body, settings),
@@ -103,12 +105,46 @@ impl IslandSet {
         true
     }
 
+    /// Checks the set's references, as a snapshot file may break them: every body slot's
+    /// sleeping island exists, lies within `body_slots` slots, and lists that body; every
+    /// member of a sleeping island is a slot below `body_slots`. The error says what is
+    /// wrong, by slot and island.
+    pub fn check(&self, body_slots: usize) -> Result<(), String> {
+        if self.sleeping_of.len() > body_slots {
+            return Err(format!(
+                "sleeping_of has {} entries for {body_slots} body slots",
+                self.sleeping_of.len()
+            ));
+        }
+        for (slot, island) in self.sleeping_of.iter().enumerate() {
+            let Some(i) = *island else { continue };
+            match self.sleeping.get(i as usize) {
+                Some(Some(members)) if members.iter().any(|m| m.index() as usize == slot) => {}
+                Some(Some(_)) => {
+                    return Err(format!("body slot {slot}: island {i} does not list it"));
+                }
+                _ => return Err(format!("body slot {slot}: no sleeping island {i}")),
+            }
+        }
+        for (i, members) in self.sleeping.iter().enumerate() {
+            for m in members.iter().flatten() {
+                if m.index() as usize >= body_slots {
+                    return Err(format!(
+                        "island {i}: member slot {} of {body_slots}",
+                        m.index()
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Forgets everything about sleeping islands except per-body membership of sleeping bodies
     /// (for a body removed from the world).
     pub fn forget(&mut self, handle: BodyHandle) {
         if let Some(slot) = self.sleeping_of.get_mut(handle.index() as usize)
             && let Some(i) = slot.take()
-            && let Some(members) = self.sleeping[i as usize].as_mut()
+            && let Some(Some(members)) = self.sleeping.get_mut(i as usize)
         {
             members.retain(|&m| m != handle);
         }
