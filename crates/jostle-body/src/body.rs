@@ -104,15 +104,29 @@ impl RigidBody {
         }
         let diag = Vec3::new(inertia.x_axis.x, inertia.y_axis.y, inertia.z_axis.z);
         let finite = inertia.to_cols_array().iter().all(|x| x.is_finite());
-        if !finite || diag.min_element() <= 0.0 || inertia.determinant() <= 0.0 {
+        if !finite || diag.min_element() <= 0.0 {
             return Err(MassError::Inertia(diag));
+        }
+        let finite_inverse = |m: &Mat3| m.to_cols_array().iter().all(|x| x.is_finite());
+        let det = inertia.determinant();
+        let mut inv_inertia = inertia.inverse();
+        if !(det.is_finite() && det > 0.0 && finite_inverse(&inv_inertia)) {
+            // Inverted at unit scale instead: the determinant of a heavy body's tensor
+            // overflows f32 (a 1 m cube of 10²² kg: (1.7·10²¹)³) and a light one's underflows,
+            // so the plain inverse is NaN or infinite where the scaled one is exact.
+            let scale = diag.max_element();
+            let unit = inertia * (1.0 / scale);
+            inv_inertia = unit.inverse() * (1.0 / scale);
+            if !(unit.determinant() > 0.0 && finite_inverse(&inv_inertia)) {
+                return Err(MassError::Inertia(diag));
+            }
         }
         let mut body = Self::fixed();
         body.fixed = false;
         body.mass = mass;
         body.inv_mass = 1.0 / mass;
         body.inertia_body = inertia;
-        body.inv_inertia_body = inertia.inverse();
+        body.inv_inertia_body = inv_inertia;
         body.update_world_inertia();
         Ok(body)
     }
@@ -285,6 +299,21 @@ impl RigidBody {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn heavy_and_light_bodies_invert_their_inertia() {
+        // A 1 m cube's tensor is m/6 on the diagonal; its determinant overflows f32 at 10²² kg
+        // and underflows at 10⁻¹⁵ kg.
+        for mass in [1e22f32, 1e30, 1e-15] {
+            let inertia = Mat3::from_diagonal(Vec3::splat(mass / 6.0));
+            let body = RigidBody::dynamic(mass, inertia).unwrap();
+            let product = body.inv_inertia_body * inertia;
+            assert!(
+                product.abs_diff_eq(Mat3::IDENTITY, 1e-5),
+                "mass {mass}: I⁻¹·I = {product}"
+            );
+        }
+    }
+
     use super::*;
 
     #[test]
