@@ -169,18 +169,10 @@ mod file {
                 settings.gravity
             ));
         }
-        let prediction = settings.collide.prediction;
-        if !(prediction.is_finite() && prediction >= 0.0) {
-            return Err(format!(
-                "settings.collide.prediction: must be finite and >= 0, got {prediction}"
-            ));
-        }
-        let frame = settings.collide.frame_tolerance;
-        if !(frame.is_finite() && frame >= 0.0) {
-            return Err(format!(
-                "settings.collide.frame_tolerance: must be finite and >= 0, got {frame}"
-            ));
-        }
+        settings
+            .collide
+            .validate()
+            .map_err(|(field, message)| format!("settings.collide.{field}: {message}"))?;
         Ok(())
     }
 

@@ -120,6 +120,11 @@ fn a_snapshot_with_invalid_settings_is_refused_by_name() {
             "settings.collide.prediction",
         ),
         (
+            "frame_angle_tolerance: 0.05",
+            "frame_angle_tolerance: 7.0",
+            "settings.collide.frame_angle_tolerance",
+        ),
+        (
             "gravity: Vec3(0.0, -9.81, 0.0)",
             "gravity: Vec3(NaN, -9.81, 0.0)",
             "settings.gravity",

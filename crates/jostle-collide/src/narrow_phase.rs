@@ -110,14 +110,15 @@ struct Frame {
 
 impl Frame {
     /// The frame to use now, given the fresh one: the held frame while both lever arms are
-    /// within `tolerance` of it and the normal within about `tolerance` radians, else the
-    /// fresh one (which is then held).
-    fn hold(held: &mut Option<Frame>, fresh: Frame, tolerance: f32) -> Frame {
+    /// within `tolerance` (m) of it and the normal within `min_cos` (the cosine of the
+    /// angular tolerance), else the fresh one (which is then held; nothing is held with a
+    /// `tolerance` of 0).
+    fn hold(held: &mut Option<Frame>, fresh: Frame, tolerance: f32, min_cos: f32) -> Frame {
         match *held {
             Some(f)
                 if f.r_a.distance_squared(fresh.r_a) < tolerance * tolerance
                     && f.r_b.distance_squared(fresh.r_b) < tolerance * tolerance
-                    && f.normal.dot(fresh.normal) > 1.0 - 0.5 * tolerance * tolerance =>
+                    && f.normal.dot(fresh.normal) > min_cos =>
             {
                 f
             }
@@ -321,6 +322,7 @@ impl NarrowPhase {
         };
         self.contacts.clear();
         self.slots.clear();
+        let min_cos = settings.frame_angle_tolerance.cos();
         let mut touching = std::mem::take(&mut self.touching_scratch);
         touching.clear();
 
@@ -396,7 +398,8 @@ impl NarrowPhase {
                         r_a: on_a - body_a.position,
                         r_b: on_b - body_b.position,
                     };
-                    let frame = Frame::hold(&mut pt.data.frame, fresh, settings.frame_tolerance);
+                    let frame =
+                        Frame::hold(&mut pt.data.frame, fresh, settings.frame_tolerance, min_cos);
                     self.contacts.push(BodyContact {
                         a,
                         b,
