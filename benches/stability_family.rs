@@ -11,7 +11,8 @@
 //! ms per step, for both engines.
 //!
 //! Run: `cargo bench --bench stability_family` (several minutes; `FAMILY=base` runs only the
-//! base family, `FAMILY=variations` only the variations; `FAMILY_ONLY` keeps the cases whose
+//! base family, `FAMILY=variations` only the variations, `FAMILY=heavy` the sweep of heavy
+//! boxes on light ones (`family::heavy_sweep`); `FAMILY_ONLY` keeps the cases whose
 //! name contains one of its `|`-separated parts, as in `family_table`). With `--test` (`cargo
 //! test --benches`) only a short smoke run is made.
 
@@ -104,11 +105,15 @@ fn main() {
     let smoke = std::env::args().any(|a| a == "--test");
     let which = std::env::var("FAMILY").unwrap_or_default();
     let mut cases = Vec::new();
-    if which != "variations" {
-        cases.extend(family::base());
-    }
-    if which != "base" {
-        cases.extend(family::variations());
+    if which == "heavy" {
+        cases.extend(family::heavy_sweep());
+    } else {
+        if which != "variations" {
+            cases.extend(family::base());
+        }
+        if which != "base" {
+            cases.extend(family::variations());
+        }
     }
     let only = std::env::var("FAMILY_ONLY").unwrap_or_default();
     cases.retain(|c| only.split('|').any(|part| c.name.contains(part)));

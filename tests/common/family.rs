@@ -368,3 +368,53 @@ pub fn variations() -> Vec<Case> {
     }
     out
 }
+
+/// Heavy boxes on light ones beyond the family's own cases: pairs and 5-box columns at 1:10
+/// to 1:10,000, each with 0.1 m and 10 m boxes, μ 0.3 and 0.9, starts perturbed from seeds the
+/// family does not use (3 to 7), and mixes of these.
+pub fn heavy_sweep() -> Vec<Case> {
+    let d = Variant::default;
+    let variants = [
+        Variant { half: 0.05, ..d() },
+        Variant { half: 5.0, ..d() },
+        Variant {
+            friction: 0.3,
+            ..d()
+        },
+        Variant {
+            friction: 0.9,
+            ..d()
+        },
+        Variant {
+            seed: Some(3),
+            ..d()
+        },
+        Variant {
+            seed: Some(4),
+            ..d()
+        },
+        Variant {
+            seed: Some(5),
+            ..d()
+        },
+        Variant {
+            half: 0.05,
+            seed: Some(6),
+            ..d()
+        },
+        Variant {
+            half: 5.0,
+            friction: 0.3,
+            seed: Some(7),
+        },
+    ];
+    let mut out = Vec::new();
+    for ratio in [10.0, 100.0, 1000.0, 10000.0] {
+        for n in [2, 5] {
+            for v in variants {
+                out.push(heavy_on_light(ratio, n, v));
+            }
+        }
+    }
+    out
+}

@@ -9,14 +9,17 @@
 //!    the previous step's impulse as the warm start; contacts with a gap above the speculative
 //!    margin, or between two immovable bodies, take no part. The contacts are packed eight
 //!    manifolds to a batch of independent bodies ([`batch`]) and every kernel below works on
-//!    eight manifolds at once ([`lanes`]).
+//!    eight manifolds at once ([`lanes`]). Small islands where a heavy body rests on light
+//!    ones are picked out and their springs sized by their load ([`direct`]).
 //! 2. per substep: integrate gravity (and the implicit gyroscopic torque) into velocities;
 //!    warm start (apply the accumulated impulses); solve every contact once with its soft bias,
 //!    the separation recomputed from the bodies' motion since the start of the step, the
 //!    push-out of deep or unloaded overlap going to pseudo velocities; integrate velocities
 //!    (and the pseudo velocities, which are then cleared) into position and rotation deltas;
 //!    relax (solve again without bias). Friction is solved in the relax pass only, unless
-//!    [`SoftStepSettings::friction_in_bias_pass`] is set.
+//!    [`SoftStepSettings::friction_in_bias_pass`] is set. After each pass the islands of
+//!    [`direct`] are solved exactly ([`direct::DirectIslands::correct`]), where Gauss-Seidel
+//!    would need about as many sweeps as their mass ratio.
 //! 3. restitution, skipped when no contact bounces: Newton's law at every point that approached
 //!    faster than the threshold, swept to convergence with the rest of the contacts, through
 //!    each body's inertia as it has turned since the start of the step
@@ -108,6 +111,7 @@ macro_rules! with_best_lanes {
 
 pub mod batch;
 pub mod body_state;
+pub mod direct;
 pub mod gyroscopic;
 pub mod integrate;
 pub mod lanes;
@@ -151,6 +155,8 @@ pub struct SoftStepResolver {
     inv_inertia_now: Vec<Mat3>,
     /// Each point's response in the restitution pass ([`solve::restitution_response`]).
     response: Vec<solve::Response>,
+    /// The islands whose normal rows are solved directly this step ([`direct`]).
+    direct: direct::DirectIslands,
 }
 
 impl SoftStepResolver {
@@ -362,6 +368,20 @@ impl Resolver for SoftStepResolver {
         let start = Instant::now();
         self.load_bodies(bodies);
         let any_restitution = self.prepare_contacts(bodies, contacts, h, ctx.gravity.length());
+        // Rigid contacts have their own push-out and no spring to size: no direct solve.
+        let direct_rows = if self.settings.rigid_contacts {
+            0
+        } else {
+            self.settings.direct_rows
+        };
+        self.direct.build(
+            &self.batches,
+            &self.states,
+            direct_rows,
+            self.settings.direct_mass_ratio,
+        );
+        self.direct
+            .stiffen(&mut self.batches, ctx.gravity.length() * h);
         stats.prepare_time = start.elapsed();
 
         let mut integrate_time = Duration::ZERO;
@@ -390,28 +410,31 @@ impl Resolver for SoftStepResolver {
 
             let t = Instant::now();
             solve::warm_start(&mut self.batches, &mut self.states);
-            solve::solve(
-                &mut self.batches,
-                &mut self.states,
-                &mut self.pseudo,
-                solve::BiasedPass {
-                    inv_h,
-                    max_push_out: push_out,
-                    slop: if rigid {
-                        self.settings.rigid_slop
-                    } else {
-                        self.settings.push_out_slop
-                    },
-                    resting_speed: self.settings.restitution_threshold,
-                    gravity_speed: ctx.gravity.length() * h,
-                    friction: self.settings.friction_in_bias_pass
-                        || self.settings.relax_iterations == 0
-                        || rigid,
-                    rigid,
-                    sweeps,
-                    rate: self.settings.push_out_rate * inv_h,
+            let pass = solve::BiasedPass {
+                inv_h,
+                max_push_out: push_out,
+                slop: if rigid {
+                    self.settings.rigid_slop
+                } else {
+                    self.settings.push_out_slop
                 },
-            );
+                resting_speed: self.settings.restitution_threshold,
+                gravity_speed: ctx.gravity.length() * h,
+                friction: self.settings.friction_in_bias_pass
+                    || self.settings.relax_iterations == 0
+                    || rigid,
+                rigid,
+                sweeps,
+                rate: self.settings.push_out_rate * inv_h,
+            };
+            solve::solve(&mut self.batches, &mut self.states, &mut self.pseudo, pass);
+            if !self.direct.is_empty() {
+                self.direct.correct(
+                    &mut self.batches,
+                    &mut self.states,
+                    solve::RowPass::Biased(pass),
+                );
+            }
             solve_time += t.elapsed();
 
             let t = Instant::now();
@@ -421,6 +444,13 @@ impl Resolver for SoftStepResolver {
             let t = Instant::now();
             for _ in 0..self.settings.relax_iterations {
                 solve::relax(&mut self.batches, &mut self.states, inv_h, sweeps);
+                if !self.direct.is_empty() {
+                    self.direct.correct(
+                        &mut self.batches,
+                        &mut self.states,
+                        solve::RowPass::Relax { inv_h },
+                    );
+                }
             }
             relax_time += t.elapsed();
         }

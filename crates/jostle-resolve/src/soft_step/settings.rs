@@ -134,6 +134,15 @@ pub struct SoftStepSettings {
     /// Overlap (m) at which load compensation (`preload_rate`) holds a loaded contact.
     /// Default 0.0005.
     pub preload_target: f32,
+    /// Largest island (count of contact points) whose normal rows are solved directly when
+    /// its bodies' masses differ widely ([`super::direct`]). Default 64; 0 turns the direct
+    /// solve off; at most [`SoftStepSettings::MAX_DIRECT_ROWS`]. Its cost grows with the cube
+    /// of the count, twice per substep.
+    pub direct_rows: u32,
+    /// Mass ratio (dimensionless, ≥ 1) between two movable bodies in contact from which their
+    /// island is solved directly ([`super::direct`]) and its springs are sized by their load.
+    /// Default 10.
+    pub direct_mass_ratio: f32,
 }
 
 impl Default for SoftStepSettings {
@@ -158,6 +167,8 @@ impl Default for SoftStepSettings {
             normal_sweeps: 8,
             preload_rate: 0.02,
             preload_target: 0.0005,
+            direct_rows: 64,
+            direct_mass_ratio: 10.0,
         }
     }
 }
@@ -168,6 +179,10 @@ impl SoftStepSettings {
     /// slower than at ζ = 10); larger values only approach a contact that never removes
     /// overlap.
     pub const MAX_DAMPING_RATIO: f32 = 1000.0;
+
+    /// The largest accepted `direct_rows`: a dense system of 256 rows costs about 3 million
+    /// operations per solve, two solves per substep.
+    pub const MAX_DIRECT_ROWS: u32 = 256;
 
     /// Normal velocity correction (m/s) below which a restitution sweep counts as converged.
     pub const RESTITUTION_TOLERANCE: f32 = 1e-5;
@@ -224,6 +239,22 @@ impl SoftStepSettings {
             ));
         }
         non_negative("preload_target", self.preload_target)?;
+        if self.direct_rows > Self::MAX_DIRECT_ROWS {
+            return Err((
+                "direct_rows",
+                format!(
+                    "must be <= {}, got {}",
+                    Self::MAX_DIRECT_ROWS,
+                    self.direct_rows
+                ),
+            ));
+        }
+        if !(self.direct_mass_ratio >= 1.0 && self.direct_mass_ratio.is_finite()) {
+            return Err((
+                "direct_mass_ratio",
+                format!("must be finite and >= 1, got {}", self.direct_mass_ratio),
+            ));
+        }
         if self.normal_sweeps == 0 {
             return Err(("normal_sweeps", "must be >= 1, got 0".into()));
         }
@@ -289,6 +320,27 @@ mod tests {
                     ..d()
                 },
                 "damping_ratio",
+            ),
+            (
+                SoftStepSettings {
+                    direct_rows: SoftStepSettings::MAX_DIRECT_ROWS + 1,
+                    ..d()
+                },
+                "direct_rows",
+            ),
+            (
+                SoftStepSettings {
+                    direct_mass_ratio: 0.5,
+                    ..d()
+                },
+                "direct_mass_ratio",
+            ),
+            (
+                SoftStepSettings {
+                    direct_mass_ratio: f32::INFINITY,
+                    ..d()
+                },
+                "direct_mass_ratio",
             ),
         ];
         for (bad, field) in cases {

@@ -409,10 +409,91 @@ fn solve_normal_rigid<F: Lane>(
     motion: (&Motion<F>, &Motion<F>),
     inv_h: F,
 ) {
+    accumulate_normal(pair, p, rigid_row(pair, p, motion, inv_h));
+}
+
+/// The increment of one rigid, unbiased normal row before the clamp ([`solve_normal_rigid`]).
+#[inline(always)]
+fn rigid_row<F: Lane>(
+    pair: &Pair<F>,
+    p: &PointLanes<F>,
+    motion: (&Motion<F>, &Motion<F>),
+    inv_h: F,
+) -> F {
     let s = separation(p, motion.0, motion.1);
     let bias = F::select(s.cmpgt(F::ZERO), s * inv_h, F::ZERO);
     let vn = pair.relative_velocity(p).dot(p.normal);
-    accumulate_normal(pair, p, -p.normal_mass * (vn + bias));
+    -p.normal_mass * (vn + bias)
+}
+
+/// Which pass a [`row_residual`] is taken in.
+#[derive(Clone, Copy, Debug)]
+pub enum RowPass {
+    /// The biased pass ([`solve`]) with these parameters.
+    Biased(BiasedPass),
+    /// The relax pass ([`relax`]) at 1/substep `inv_h` (1/s).
+    Relax {
+        /// 1/substep (1/s).
+        inv_h: f32,
+    },
+}
+
+/// A point's row as a pass would solve it next ([`row_residuals`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RowState {
+    /// The velocity change the row asks for (m/s): the impulse change x it wants meets
+    /// (J·M⁻¹·Jᵀ·x) + compliance·x = r, before its clamp.
+    pub r: f32,
+    /// The row's compliance (m/s per N·s).
+    pub compliance: f32,
+}
+
+/// The row of point `point` (an index into `batches.points`) of every lane of batch `batch`
+/// at the bodies' current velocities, as the pass would solve it next, lane by lane;
+/// [`super::direct`] solves these rows of a whole island at once. The same arithmetic as
+/// the pass's own kernels.
+pub fn row_residuals(
+    batches: &Batches,
+    states: &[BodyState],
+    batch: usize,
+    point: usize,
+    pass: RowPass,
+) -> [RowState; LANES] {
+    let m = &batches.manifolds[batch];
+    let p = &batches.points[point];
+    let pair = Pair::<F8>::load(m, states);
+    let motion = (&gather_motion(states, m.a), &gather_motion(states, m.b));
+    let soft_mass = p.normal_mass * p.mass_scale;
+    let (delta, mass, compliance) = match pass {
+        RowPass::Biased(pass) => {
+            let row = biased_row(&pair, p, motion, &BiasedConsts::new(&pass));
+            (row.delta, row.mass, row.compliance)
+        }
+        RowPass::Relax { inv_h } => {
+            // The rigid row, with its spring's compliance all the same: the rows of a face
+            // span fewer motions than it has points, and a speculative row's gap rule need
+            // not agree with any rigid motion at all; the compliance shares the impulse among
+            // them as the springs do, where a rigid solve would put it on some points only.
+            let spring = F8::select(
+                soft_mass.cmpgt(F8::ZERO),
+                p.impulse_scale / soft_mass,
+                F8::ZERO,
+            );
+            (
+                rigid_row(&pair, p, motion, F8::splat(inv_h)),
+                p.normal_mass,
+                spring,
+            )
+        }
+    };
+    std::array::from_fn(|l| RowState {
+        r: if mass[l] > 0.0 {
+            delta[l] / mass[l]
+        } else {
+            0.0
+        },
+        compliance: compliance[l],
+    })
 }
 
 /// The normal velocity of A's point relative to B's under the pseudo velocities (m/s).
@@ -562,6 +643,82 @@ fn solve_batch_rigid<F: Lane>(
     }
 }
 
+/// [`BiasedPass`]'s numbers as lanes, splatted once per batch.
+struct BiasedConsts<F> {
+    inv_h: F,
+    push_out: F,
+    resting_speed: F,
+    slop: F,
+    gravity_speed: F,
+}
+
+impl<F: Lane> BiasedConsts<F> {
+    #[inline(always)]
+    fn new(pass: &BiasedPass) -> Self {
+        Self {
+            inv_h: F::splat(pass.inv_h),
+            push_out: F::splat(-pass.max_push_out),
+            resting_speed: F::splat(-pass.resting_speed),
+            slop: F::splat(pass.slop),
+            gravity_speed: F::splat(pass.gravity_speed),
+        }
+    }
+}
+
+/// One point's row in the biased pass at the pair's current velocities
+/// ([`solve_batch_split`]): the increment of its normal impulse before the clamp, the
+/// overlap's excess for the pseudo velocities, and the row as a linear equation in the
+/// impulse, `delta = −mass·(vₙ + c + compliance·λ)` (for [`super::direct`]).
+struct BiasedRow<F> {
+    delta: F,
+    excess: F,
+    mass: F,
+    compliance: F,
+}
+
+#[inline(always)]
+fn biased_row<F: Lane>(
+    pair: &Pair<F>,
+    p: &PointLanes<F>,
+    (motion_a, motion_b): (&Motion<F>, &Motion<F>),
+    c: &BiasedConsts<F>,
+) -> BiasedRow<F> {
+    let s = separation(p, motion_a, motion_b);
+    let speculative = s.cmpgt(F::ZERO);
+    let soft_mass = p.normal_mass * p.mass_scale;
+    let bleed = p.impulse_scale * p.normal_impulse;
+    // The bias as an impulse (≤ 0 on overlap), with the spring compressed by its preload
+    // too (in proportion to the overlap up to the full preload: a preload that set in at
+    // first touch would pump the bounces of a rocking box), and the part of it the load
+    // explains.
+    let extra = (-s * p.preload_slope).max(F::ZERO);
+    let extra = F::select(extra.cmpgt(p.preload), p.preload, extra);
+    let spring = F::select(speculative, s, s - extra);
+    let bias = soft_mass * (p.bias_rate * spring).max(c.push_out);
+    let resting = p.normal_impulse.cmpgt(F::ZERO) & c.resting_speed.cmplt(p.relative_velocity);
+    let allowance = F::select(resting, p.bias_rate * c.slop + c.gravity_speed, F::ZERO);
+    let vn = pair.relative_velocity(p).dot(p.normal);
+    let carried = bias.max(-bleed - soft_mass * allowance);
+    let excess = F::select(speculative, F::ZERO, bias - carried);
+
+    let rigid = -p.normal_mass * (vn + s * c.inv_h);
+    let soft = -soft_mass * vn - carried - bleed;
+    BiasedRow {
+        delta: F::select(speculative, rigid, soft),
+        excess,
+        mass: F::select(speculative, p.normal_mass, soft_mass),
+        // Exact where the bias is carried (the bleed stays in the row: a spring). Where the
+        // allowance holds, or the point is speculative, the row is rigid; its spring's
+        // compliance is kept all the same, so that the rows of a face, whose targets need
+        // not agree with any rigid motion there, stay a well-posed system.
+        compliance: F::select(
+            soft_mass.cmpgt(F::ZERO),
+            p.impulse_scale / soft_mass,
+            F::ZERO,
+        ),
+    }
+}
+
 /// The biased pass over one batch, with split impulses for overlap beyond what the load
 /// explains.
 ///
@@ -597,47 +754,18 @@ fn solve_batch_split<F: Lane>(
     states: &[BodyState],
     pass: BiasedPass,
 ) {
-    let BiasedPass {
-        inv_h,
-        max_push_out,
-        slop,
-        resting_speed,
-        gravity_speed,
-        friction,
-        ..
-    } = pass;
+    let friction = pass.friction;
     let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
-    let inv_h = F::splat(inv_h);
-    let push_out = F::splat(-max_push_out);
-    let resting_speed = F::splat(-resting_speed);
-    let slop = F::splat(slop);
-    let gravity_speed = F::splat(gravity_speed);
+    let consts = BiasedConsts::new(&pass);
     for p in points.iter_mut() {
-        let s = separation(p, &motion_a, &motion_b);
-        let speculative = s.cmpgt(F::ZERO);
-        let soft_mass = p.normal_mass * p.mass_scale;
-        let bleed = p.impulse_scale * p.normal_impulse;
-        // The bias as an impulse (≤ 0 on overlap), with the spring compressed by its preload
-        // too (in proportion to the overlap up to the full preload: a preload that set in at
-        // first touch would pump the bounces of a rocking box), and the part of it the load
-        // explains.
-        let extra = (-s * p.preload_slope).max(F::ZERO);
-        let extra = F::select(extra.cmpgt(p.preload), p.preload, extra);
-        let spring = F::select(speculative, s, s - extra);
-        let bias = soft_mass * (p.bias_rate * spring).max(push_out);
-        let resting = p.normal_impulse.cmpgt(F::ZERO) & resting_speed.cmplt(p.relative_velocity);
-        let allowance = F::select(resting, p.bias_rate * slop + gravity_speed, F::ZERO);
-        let vn = pair.relative_velocity(p).dot(p.normal);
-        let carried = bias.max(-bleed - soft_mass * allowance);
-        let excess = F::select(speculative, F::ZERO, bias - carried);
-
-        let rigid = -p.normal_mass * (vn + s * inv_h);
-        let soft = -soft_mass * vn - carried - bleed;
-        accumulate_normal(pair, p, F::select(speculative, rigid, soft));
+        let row = biased_row(pair, p, (&motion_a, &motion_b), &consts);
+        accumulate_normal(pair, p, row.delta);
 
         // Pseudo velocities can only change where some lane has excess overlap or the
         // bodies already move with pseudo velocities (`live`); elsewhere push would be 0.
+        let excess = row.excess;
         if *live || excess.cmplt(F::ZERO).any() {
+            let soft_mass = p.normal_mass * p.mass_scale;
             let vpn = pseudo_normal_velocity(pseudo, p);
             let push = (-soft_mass * vpn - excess).max(F::ZERO);
             apply_pseudo(pseudo, pair, p, push);

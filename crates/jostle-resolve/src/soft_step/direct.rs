@@ -1,0 +1,778 @@
+//! Direct solve of the contact rows of small islands whose bodies' masses differ widely: a
+//! heavy body resting on light ones.
+//!
+//! Gauss-Seidel converges on a light body squeezed between a heavy one and the ground at a
+//! rate of about 1 − m/M per sweep: the heavy body's weight must reach the ground through
+//! rows whose effective mass is the light body's, and each sweep passes on only about m/M of
+//! what is missing (a 1:1,000 pair needs thousands of sweeps where a step has sixteen); the
+//! friction rows that hold the heavy body sideways are conditioned the same way. The soft
+//! springs add a second limit: a spring sized by the light body's effective mass
+//! (k = m·ω²) settles at a compression of M·g/(m·ω²) under the heavy load, and load
+//! compensation may take only part of it back before the load rides on the spring
+//! under-damped ([`super::PRELOAD_MIN_DAMPING`]). Measured on the stability family (the
+//! `jostle` crate's benches/RESULTS.md, "Heavy on light: a direct solve"): springs sized by
+//! their load with 300 Gauss-Seidel sweeps per pass hold a light box under 1,000 times its
+//! mass with 0.1 mm of sink but not a column of five such boxes, and either change alone
+//! lets both fall.
+//!
+//! So for an island of at most [`super::SoftStepSettings::direct_rows`] contact points that
+//! holds a contact between two movable bodies whose masses differ by
+//! [`super::SoftStepSettings::direct_mass_ratio`] or more:
+//! 1. [`DirectIslands::stiffen`], once per step: each manifold's springs are sized by the
+//!    mass its load stands for, Λ/(|g|·h) for the per-substep impulse Λ its points start the
+//!    step with, where that exceeds their effective mass (the same ω and ζ, so a loaded
+//!    manifold settles at about g/ω² whatever its load);
+//! 2. after each biased and each relax pass, [`DirectIslands::correct`] solves the island's
+//!    rows exactly as the pass states them ([`super::solve::row_residuals`]):
+//!    (J·M⁻¹·Jᵀ + C)·x = r, with C the springs' compliance, over the normal rows that push
+//!    or want to, and in the relax pass over their friction rows too, as sticking. An active
+//!    set: normal rows whose total would pull are fixed at no impulse, friction that would
+//!    leave its cone is fixed on it, and the rest is solved again. The system is factorised
+//!    by Cholesky in f64 (rows that depend on others, as the four points of a face do, get no
+//!    impulse of their own), once per step and free set, and the result goes to the bodies
+//!    and to the accumulated impulses; in the relax pass only if it takes kinetic energy out
+//!    (friction fixed on its cone is no projection and can put energy in). The pseudo
+//!    velocities of the push-out stay with Gauss-Seidel (solving them directly too measured
+//!    worse, same section).
+//!
+//! Islands of bodies of similar mass keep the plain soft step: there Gauss-Seidel converges,
+//! and springs stiffened by their load made tall columns sway by decimetres (same section).
+//! The cost is the factorisation, cubic in the island's rows: 0.03 ms a step for a pair,
+//! 0.1 ms for a light column of five under a heavy box (0.01 ms each without).
+
+use super::batch::{Batches, LANES, NO_SOURCE};
+use super::body_state::BodyState;
+use super::solve::{RowPass, RowState, row_residuals};
+use crate::STATIC_BODY;
+use jostle_math::Vec3;
+
+/// A pivot below this fraction of its row's diagonal marks the row as depending on the rows
+/// before it ([`cholesky_solve`]). Rows built from f32 data are dependent to about 1e-14 of
+/// their diagonal; a light body under a 10,000 times heavier one leaves about 1e-5.
+const DEPENDENT: f64 = 1e-9;
+
+/// Rounds of fixing rows that would pull or slide before the island is left to Gauss-Seidel
+/// alone.
+const ACTIVE_SET_ROUNDS: usize = 8;
+
+/// Relative slack of the friction cone in [`Solver::fix_sliding_points`]: a point is sliding
+/// when its sticking friction exceeds μ times its normal impulse by more than this.
+const CONE_TOLERANCE: f64 = 1e-6;
+
+/// One normal row of a direct island: where it lives in the batches, and its Jacobian.
+#[derive(Clone, Copy, Debug)]
+struct Row {
+    /// The direct island's number, then the row's place in the batches: the sort key.
+    island: u32,
+    order: u32,
+    /// Which impulse of the point the row is: [`NORMAL`], [`TANGENT_1`] or [`TANGENT_2`].
+    kind: u8,
+    batch: u32,
+    point: u32,
+    lane: u8,
+    a: u32,
+    b: u32,
+    inv_mass_a: f32,
+    inv_mass_b: f32,
+    /// The row's direction d: the normal or a tangent.
+    normal: Vec3,
+    /// r_A × d and r_B × d.
+    rn_a: Vec3,
+    rn_b: Vec3,
+    /// I_A⁻¹·(r_A × d) and I_B⁻¹·(r_B × d).
+    ang_a: Vec3,
+    ang_b: Vec3,
+}
+
+/// A point's normal row.
+const NORMAL: u8 = 0;
+/// A point's friction row along its first tangent.
+const TANGENT_1: u8 = 1;
+/// A point's friction row along its second tangent.
+const TANGENT_2: u8 = 2;
+
+impl Row {
+    /// The change of this row's normal velocity per unit impulse on `other`: (J·M⁻¹·Jᵀ)ᵢⱼ.
+    fn coupling(&self, other: &Row) -> f64 {
+        let mine = [(self.a, 1.0, self.rn_a), (self.b, -1.0, self.rn_b)];
+        let theirs = [
+            (other.a, 1.0, other.ang_a, other.inv_mass_a),
+            (other.b, -1.0, other.ang_b, other.inv_mass_b),
+        ];
+        let mut sum = 0.0f64;
+        for (body, sign, rn) in mine {
+            if body == STATIC_BODY {
+                continue;
+            }
+            for &(other_body, other_sign, ang, inv_mass) in &theirs {
+                if other_body == body {
+                    let k = inv_mass * self.normal.dot(other.normal) + rn.dot(ang);
+                    sum += f64::from(sign * other_sign * k);
+                }
+            }
+        }
+        sum
+    }
+}
+
+/// The islands of one step that are solved directly, and the scratch to solve them.
+#[derive(Clone, Debug, Default)]
+pub struct DirectIslands {
+    /// The rows of every direct island, island by island.
+    rows: Vec<Row>,
+    /// Each direct island's range in `rows`.
+    islands: Vec<(u32, u32)>,
+    /// Each island's (J·M⁻¹·Jᵀ)ᵢⱼ over all its rows (row-major), one island after another:
+    /// the rows do not change within a step.
+    couplings: Vec<f64>,
+    /// Each island's last [`FACTORS`] factorisations of each pass kind (biased, relax),
+    /// reused while its free rows are the same as one of them: within a step the couplings
+    /// and the compliances do not change.
+    factors: Vec<[Vec<Factor>; 2]>,
+    // Scratch reused from step to step.
+    parent: Vec<u32>,
+    row_count: Vec<u32>,
+    mixed: Vec<bool>,
+    island_of: Vec<u32>,
+    solver: Solver,
+}
+
+/// A Cholesky factor of an island's system over the free rows `index`, last used in round
+/// `used` of the step.
+#[derive(Clone, Debug, Default)]
+struct Factor {
+    index: Vec<usize>,
+    matrix: Vec<f64>,
+    used: u64,
+}
+
+/// Factorisations kept per island and pass kind: the active set of a resting island
+/// alternates between a few free sets (all rows, then those left after fixing pulling or
+/// sliding ones), each met again in every substep.
+const FACTORS: usize = 4;
+
+/// The dense solve of one island at a time, with its scratch.
+#[derive(Clone, Debug, Default)]
+struct Solver {
+    /// The right-hand side over the free rows, then their impulse changes.
+    rhs: Vec<f64>,
+    /// Each row as the pass states it.
+    residual: Vec<RowState>,
+    /// Each row's accumulated impulse at the start of the solve.
+    impulse: Vec<f32>,
+    /// Each row's part in the solve.
+    role: Vec<Role>,
+    /// Each row's impulse change: solved for free rows, given for fixed ones.
+    change: Vec<f64>,
+    /// The free rows, in order.
+    index: Vec<usize>,
+    /// Solves so far, for the factorisations' last use.
+    round: u64,
+}
+
+/// A row's part in an island's solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Role {
+    /// Takes no part: its impulse stays as it is.
+    Out,
+    /// Solved for.
+    Free,
+    /// Its impulse change is given ([`Solver::change`]): a normal row that would pull (set
+    /// to no impulse) and its friction, or friction that would leave its cone (set on it).
+    Fixed,
+}
+
+/// No island (a root that is not solved directly).
+const NONE: u32 = u32::MAX;
+
+impl DirectIslands {
+    /// Number of islands solved directly this step.
+    pub fn len(&self) -> usize {
+        self.islands.len()
+    }
+
+    /// Whether no island is solved directly this step.
+    pub fn is_empty(&self) -> bool {
+        self.islands.is_empty()
+    }
+
+    /// Finds this step's direct islands in the packed `batches`: bodies joined by manifolds
+    /// between two movable bodies, kept when they have at most `max_rows` normal rows and
+    /// some manifold joins two movable bodies whose inverse masses differ by `mass_ratio` or
+    /// more. Deterministic: islands and rows in the batches' order.
+    pub fn build(
+        &mut self,
+        batches: &Batches,
+        states: &[BodyState],
+        max_rows: u32,
+        mass_ratio: f32,
+    ) {
+        self.rows.clear();
+        self.islands.clear();
+        if max_rows == 0 || batches.manifolds.is_empty() {
+            return;
+        }
+        let movable = |i: u32| i != STATIC_BODY && states[i as usize].inv_mass > 0.0;
+        self.parent.clear();
+        self.parent.extend(0..states.len() as u32);
+        for m in &batches.manifolds {
+            for l in 0..LANES {
+                if movable(m.a[l]) && movable(m.b[l]) {
+                    union(&mut self.parent, m.a[l], m.b[l]);
+                }
+            }
+        }
+        self.row_count.clear();
+        self.row_count.resize(states.len(), 0);
+        self.mixed.clear();
+        self.mixed.resize(states.len(), false);
+        let root_of = |parent: &mut Vec<u32>, a: u32, b: u32| {
+            let body = if movable(a) { a } else { b };
+            movable(body).then(|| find(parent, body))
+        };
+        for m in &batches.manifolds {
+            let points = &batches.sources[m.first as usize..(m.first + m.count) as usize];
+            for l in 0..LANES {
+                let Some(root) = root_of(&mut self.parent, m.a[l], m.b[l]) else {
+                    continue;
+                };
+                let rows = points.iter().filter(|s| s[l] != NO_SOURCE).count() as u32;
+                self.row_count[root as usize] += rows;
+                let (ia, ib) = (m.inv_mass_a[l], m.inv_mass_b[l]);
+                if movable(m.a[l]) && movable(m.b[l]) && ia.max(ib) >= mass_ratio * ia.min(ib) {
+                    self.mixed[root as usize] = true;
+                }
+            }
+        }
+        self.island_of.clear();
+        self.island_of.resize(states.len(), NONE);
+        let mut islands = 0u32;
+        for (bi, m) in batches.manifolds.iter().enumerate() {
+            for l in 0..LANES {
+                let Some(root) = root_of(&mut self.parent, m.a[l], m.b[l]) else {
+                    continue;
+                };
+                let r = root as usize;
+                if !self.mixed[r] || self.row_count[r] > max_rows {
+                    continue;
+                }
+                if self.island_of[r] == NONE {
+                    self.island_of[r] = islands;
+                    islands += 1;
+                }
+                for k in m.first..m.first + m.count {
+                    if batches.sources[k as usize][l] == NO_SOURCE {
+                        continue;
+                    }
+                    let p = &batches.points[k as usize];
+                    let (r_a, r_b) = (p.r_a.lane(l), p.r_b.lane(l));
+                    let rows = [
+                        (NORMAL, p.normal, p.ang_a_normal, p.ang_b_normal),
+                        (TANGENT_1, p.tangent1, p.ang_a_tangent1, p.ang_b_tangent1),
+                        (TANGENT_2, p.tangent2, p.ang_a_tangent2, p.ang_b_tangent2),
+                    ];
+                    let kinds = if p.friction[l] > 0.0 { 3 } else { 1 };
+                    for (kind, d, ang_a, ang_b) in rows.into_iter().take(kinds) {
+                        let d = d.lane(l);
+                        self.rows.push(Row {
+                            island: self.island_of[r],
+                            order: self.rows.len() as u32,
+                            kind,
+                            batch: bi as u32,
+                            point: k,
+                            lane: l as u8,
+                            a: m.a[l],
+                            b: m.b[l],
+                            inv_mass_a: m.inv_mass_a[l],
+                            inv_mass_b: m.inv_mass_b[l],
+                            normal: d,
+                            rn_a: r_a.cross(d),
+                            rn_b: r_b.cross(d),
+                            ang_a: ang_a.lane(l),
+                            ang_b: ang_b.lane(l),
+                        });
+                    }
+                }
+            }
+        }
+        // Rows island by island, each island's in the batches' order.
+        self.rows.sort_unstable_by_key(|r| (r.island, r.order));
+        let mut start = 0usize;
+        for i in 1..=self.rows.len() {
+            if i == self.rows.len() || self.rows[i].island != self.rows[start].island {
+                self.islands.push((start as u32, i as u32));
+                start = i;
+            }
+        }
+        self.couplings.clear();
+        for &(start, end) in &self.islands {
+            let rows = &self.rows[start as usize..end as usize];
+            for a in rows {
+                self.couplings.extend(rows.iter().map(|b| a.coupling(b)));
+            }
+        }
+        self.factors
+            .resize_with(self.islands.len(), Default::default);
+        for factors in &mut self.factors {
+            for kind in factors {
+                kind.clear();
+            }
+        }
+    }
+
+    /// Sizes each direct manifold's springs by the mass its load stands for: where the
+    /// per-substep impulse Λ its points start with (summed) exceeds what their effective
+    /// masses M (summed) weigh in one substep (M·|g|·h, `weight_impulse` = |g|·h), each of its
+    /// springs has the stiffness and damping of Λ/(M·|g|·h) times its own mass at the same
+    /// frequency and damping ratio: the mass scale s and impulse scale 1 − s of
+    /// [`super::Softness`] with hω(2ζ + hω) multiplied by that ratio. One ratio for the whole
+    /// manifold: sized point by point, a point the narrow phase has just found (no impulse to
+    /// start from) stays soft while its neighbours are stiff, and they take its load.
+    pub fn stiffen(&self, batches: &mut Batches, weight_impulse: f32) {
+        if !(weight_impulse > 0.0) {
+            return;
+        }
+        let mut start = 0;
+        while start < self.rows.len() {
+            let manifold = (self.rows[start].batch, self.rows[start].lane);
+            let end = start
+                + self.rows[start..]
+                    .iter()
+                    .take_while(|r| (r.batch, r.lane) == manifold)
+                    .count();
+            let rows = &self.rows[start..end];
+            start = end;
+            let (mut load, mut mass) = (0.0f32, 0.0f32);
+            for row in rows.iter().filter(|r| r.kind == NORMAL) {
+                let p = &batches.points[row.point as usize];
+                load += p.normal_impulse[row.lane as usize];
+                mass += p.normal_mass[row.lane as usize];
+            }
+            let ratio = load / (mass * weight_impulse);
+            if !(ratio > 1.0 && ratio.is_finite()) {
+                continue;
+            }
+            for row in rows.iter().filter(|r| r.kind == NORMAL) {
+                let p = &mut batches.points[row.point as usize];
+                let l = row.lane as usize;
+                let (mass_scale, impulse_scale) = (p.mass_scale[l], p.impulse_scale[l]);
+                if impulse_scale > 0.0 {
+                    let a = mass_scale / impulse_scale * ratio;
+                    p.mass_scale[l] = a / (1.0 + a);
+                    p.impulse_scale[l] = 1.0 / (1.0 + a);
+                }
+            }
+        }
+    }
+
+    /// Solves every direct island's normal rows as `pass` states them, and applies the
+    /// result to `states` and to the accumulated impulses in `batches`.
+    pub fn correct(&mut self, batches: &mut Batches, states: &mut [BodyState], pass: RowPass) {
+        let kind = match pass {
+            RowPass::Biased(_) => 0,
+            RowPass::Relax { .. } => 1,
+        };
+        let mut offset = 0;
+        for (island, &(start, end)) in self.islands.iter().enumerate() {
+            let rows = &self.rows[start as usize..end as usize];
+            let couplings = &self.couplings[offset..offset + rows.len() * rows.len()];
+            offset += rows.len() * rows.len();
+            let factors = &mut self.factors[island][kind];
+            self.solver
+                .solve_island(batches, states, rows, couplings, factors, pass);
+        }
+    }
+}
+
+impl Solver {
+    /// Solves the island's rows as `pass` states them and applies the result: the normal
+    /// rows, and in the relax pass the friction rows as sticking, with every normal impulse
+    /// at least 0 and every point's friction within μ times its normal impulse. An active set:
+    /// a normal row whose total would pull is fixed at no impulse (with its friction), a
+    /// point whose friction would leave its disk has it fixed on the disk, and the rest is
+    /// solved again, for at most [`ACTIVE_SET_ROUNDS`] rounds; an island whose rounds run out
+    /// is left to Gauss-Seidel.
+    fn solve_island(
+        &mut self,
+        batches: &mut Batches,
+        states: &mut [BodyState],
+        rows: &[Row],
+        couplings: &[f64],
+        factors: &mut Vec<Factor>,
+        pass: RowPass,
+    ) {
+        let friction = matches!(pass, RowPass::Relax { .. });
+        self.residual.clear();
+        self.impulse.clear();
+        self.role.clear();
+        self.change.clear();
+        for (i, row) in rows.iter().enumerate() {
+            let l = row.lane as usize;
+            let p = &batches.points[row.point as usize];
+            let (residual, impulse, role) = match row.kind {
+                NORMAL => {
+                    let row = row_residuals(
+                        batches,
+                        states,
+                        row.batch as usize,
+                        row.point as usize,
+                        pass,
+                    )[l];
+                    let impulse = p.normal_impulse[l];
+                    let role = if impulse > 0.0 || row.r > 0.0 {
+                        Role::Free
+                    } else {
+                        Role::Out
+                    };
+                    (row, impulse, role)
+                }
+                kind => {
+                    // Sticking: no sliding at the point, with the compliance of its normal
+                    // row (the row before the first tangent's, two before the second's), so
+                    // the friction of a face's points, which span fewer motions than they are
+                    // rows, is shared as the normal load is.
+                    let normal = i - kind as usize;
+                    let impulse = p.tangent_impulse[kind as usize - 1][l];
+                    let role = if friction {
+                        self.role[normal]
+                    } else {
+                        Role::Out
+                    };
+                    let state = RowState {
+                        r: -row.velocity(states),
+                        compliance: self.residual[normal].compliance,
+                    };
+                    (state, impulse, role)
+                }
+            };
+            self.residual.push(residual);
+            self.impulse.push(impulse);
+            self.role.push(role);
+            self.change.push(0.0);
+        }
+        for _ in 0..ACTIVE_SET_ROUNDS {
+            if !self.solve_free(couplings, factors) {
+                return;
+            }
+            if !self.fix_pulling_rows(rows) && !self.fix_sliding_points(rows, batches) {
+                // The relax pass only takes velocity out; a solution whose fixed rows (the
+                // friction cone's, above all) would put kinetic energy in is not applied.
+                if friction && self.energy_change(rows, couplings, states) > 0.0 {
+                    return;
+                }
+                self.apply(rows, batches, states);
+                return;
+            }
+        }
+    }
+
+    /// Solves (J·M⁻¹·Jᵀ + C)·x = r over the free rows, the fixed rows' changes moved to the
+    /// right-hand side; the changes go to [`Solver::change`]. `couplings` is J·M⁻¹·Jᵀ over
+    /// all the island's rows; a factorisation of `factors` with the same free rows is reused.
+    /// False when there is nothing to solve or the factorisation fails.
+    fn solve_free(&mut self, couplings: &[f64], factors: &mut Vec<Factor>) -> bool {
+        let all = self.role.len();
+        self.index.clear();
+        self.index
+            .extend((0..all).filter(|&i| self.role[i] == Role::Free));
+        let n = self.index.len();
+        if n == 0 {
+            return self.role.contains(&Role::Fixed);
+        }
+        self.round += 1;
+        let found = factors.iter().position(|f| f.index == self.index);
+        let slot = match found {
+            Some(slot) => slot,
+            None => {
+                let slot = if factors.len() < FACTORS {
+                    factors.push(Factor::default());
+                    factors.len() - 1
+                } else {
+                    (0..factors.len())
+                        .min_by_key(|&k| factors[k].used)
+                        .unwrap_or(0)
+                };
+                let factor = &mut factors[slot];
+                factor.index.clone_from(&self.index);
+                factor.matrix.clear();
+                factor.matrix.resize(n * n, 0.0);
+                for (i, &ri) in self.index.iter().enumerate() {
+                    for (j, &rj) in self.index.iter().enumerate().take(i + 1) {
+                        factor.matrix[i * n + j] = couplings[ri * all + rj];
+                    }
+                    factor.matrix[i * n + i] += f64::from(self.residual[ri].compliance);
+                }
+                if !cholesky_factor(&mut factor.matrix, n) {
+                    factor.index.clear();
+                    return false;
+                }
+                slot
+            }
+        };
+        factors[slot].used = self.round;
+        let factor = &factors[slot];
+        self.rhs.clear();
+        self.rhs
+            .extend(self.index.iter().map(|&ri| f64::from(self.residual[ri].r)));
+        for k in (0..all).filter(|&k| self.role[k] == Role::Fixed) {
+            for (rhs, &ri) in self.rhs.iter_mut().zip(&self.index) {
+                *rhs -= couplings[ri * all + k] * self.change[k];
+            }
+        }
+        cholesky_substitute(&factor.matrix, &mut self.rhs, n);
+        for (i, &ri) in self.index.iter().enumerate() {
+            self.change[ri] = self.rhs[i];
+        }
+        true
+    }
+
+    /// The change of the bodies' kinetic energy (J) that the solution found would make:
+    /// xᵀ·J·v + ½·xᵀ·J·M⁻¹·Jᵀ·x over the rows that change.
+    fn energy_change(&self, rows: &[Row], couplings: &[f64], states: &[BodyState]) -> f64 {
+        let all = rows.len();
+        let mut change = 0.0;
+        for (i, row) in rows.iter().enumerate() {
+            if self.role[i] == Role::Out {
+                continue;
+            }
+            let x = self.change[i];
+            let coupled: f64 = (0..all)
+                .filter(|&k| self.role[k] != Role::Out)
+                .map(|k| couplings[i * all + k] * self.change[k])
+                .sum();
+            change += x * (f64::from(row.velocity(states)) + 0.5 * coupled);
+        }
+        change
+    }
+
+    /// The total impulse of row `i` with its change.
+    fn total(&self, i: usize) -> f64 {
+        f64::from(self.impulse[i]) + self.change[i]
+    }
+
+    /// Fixes every free normal row whose total would pull at no impulse, with its friction;
+    /// true when any was.
+    fn fix_pulling_rows(&mut self, rows: &[Row]) -> bool {
+        let mut any = false;
+        for (i, row) in rows.iter().enumerate() {
+            if row.kind != NORMAL || self.role[i] != Role::Free || self.total(i) >= 0.0 {
+                continue;
+            }
+            any = true;
+            // The normal row and the friction rows that follow it.
+            let point = 1 + rows[i + 1..]
+                .iter()
+                .take_while(|r| r.kind != NORMAL)
+                .count();
+            for k in i..i + point {
+                if self.role[k] != Role::Out {
+                    self.role[k] = Role::Fixed;
+                    self.change[k] = -f64::from(self.impulse[k]);
+                }
+            }
+        }
+        any
+    }
+
+    /// Fixes the friction of every point whose sticking friction would leave its disk (μ
+    /// times its normal impulse) on the disk, in the direction it asked for; true when any was.
+    fn fix_sliding_points(&mut self, rows: &[Row], batches: &Batches) -> bool {
+        let mut any = false;
+        for (i, row) in rows.iter().enumerate() {
+            if row.kind != TANGENT_1 || self.role[i] != Role::Free {
+                continue;
+            }
+            let mu = f64::from(batches.points[row.point as usize].friction[row.lane as usize]);
+            let limit = mu * self.total(i - 1).max(0.0);
+            let (t1, t2) = (self.total(i), self.total(i + 1));
+            let length = (t1 * t1 + t2 * t2).sqrt();
+            if length > limit * (1.0 + CONE_TOLERANCE) {
+                let scale = limit / length;
+                for (k, t) in [(i, t1), (i + 1, t2)] {
+                    self.role[k] = Role::Fixed;
+                    self.change[k] = t * scale - f64::from(self.impulse[k]);
+                }
+                any = true;
+            }
+        }
+        any
+    }
+
+    /// Applies the changes of the free and fixed rows to the accumulated impulses and to the
+    /// bodies.
+    fn apply(&self, rows: &[Row], batches: &mut Batches, states: &mut [BodyState]) {
+        for (i, row) in rows.iter().enumerate() {
+            if self.role[i] == Role::Out {
+                continue;
+            }
+            let l = row.lane as usize;
+            let p = &mut batches.points[row.point as usize];
+            let total = self.total(i) as f32;
+            let slot = match row.kind {
+                NORMAL => &mut p.normal_impulse[l],
+                kind => &mut p.tangent_impulse[kind as usize - 1][l],
+            };
+            let total = if row.kind == NORMAL {
+                total.max(0.0)
+            } else {
+                total
+            };
+            let delta = total - *slot;
+            if !delta.is_finite() {
+                continue;
+            }
+            *slot = total;
+            if row.kind == NORMAL {
+                p.max_normal_impulse[l] = p.max_normal_impulse[l].max(delta);
+            }
+            row.apply(states, delta);
+        }
+    }
+}
+
+impl Row {
+    /// The velocity of A's point relative to B's along the row's direction (m/s).
+    fn velocity(&self, states: &[BodyState]) -> f32 {
+        let (a, b) = (&states[self.a as usize], &states[self.b as usize]);
+        self.normal.dot(a.linear_velocity - b.linear_velocity) + self.rn_a.dot(a.angular_velocity)
+            - self.rn_b.dot(b.angular_velocity)
+    }
+
+    /// Applies the impulse `delta` along the row (on A, opposite on B).
+    fn apply(&self, states: &mut [BodyState], delta: f32) {
+        let impulse = self.normal * delta;
+        if self.a != STATIC_BODY {
+            let s = &mut states[self.a as usize];
+            s.linear_velocity += impulse * self.inv_mass_a;
+            s.angular_velocity += self.ang_a * delta;
+        }
+        if self.b != STATIC_BODY {
+            let s = &mut states[self.b as usize];
+            s.linear_velocity -= impulse * self.inv_mass_b;
+            s.angular_velocity -= self.ang_b * delta;
+        }
+    }
+}
+
+/// Factorises the symmetric positive semi-definite `a` (n × n, row-major, the lower
+/// triangle read) in place as L·Lᵀ. A row whose pivot falls below [`DEPENDENT`] times its
+/// diagonal depends on the rows before it (the rows of a face span fewer motions than it
+/// has points): its column of L is zero, and [`cholesky_substitute`] gives it no impulse
+/// while the others meet it as far as it is consistent with them. False when a pivot is
+/// not finite.
+fn cholesky_factor(a: &mut [f64], n: usize) -> bool {
+    for j in 0..n {
+        let diagonal = a[j * n + j];
+        let mut d = diagonal;
+        for k in 0..j {
+            d -= a[j * n + k] * a[j * n + k];
+        }
+        if !d.is_finite() {
+            return false;
+        }
+        if !(d > DEPENDENT * diagonal) {
+            for i in j..n {
+                a[i * n + j] = 0.0;
+            }
+            continue;
+        }
+        let d = d.sqrt();
+        a[j * n + j] = d;
+        for i in j + 1..n {
+            let mut s = a[i * n + j];
+            for k in 0..j {
+                s -= a[i * n + k] * a[j * n + k];
+            }
+            a[i * n + j] = s / d;
+        }
+    }
+    true
+}
+
+/// Solves L·Lᵀ·x = b in place (`b` becomes x) with the factor of [`cholesky_factor`]; a
+/// dependent row's x is 0.
+fn cholesky_substitute(l: &[f64], b: &mut [f64], n: usize) {
+    for i in 0..n {
+        let row = &l[i * n..i * n + i + 1];
+        let s = b[i]
+            - row[..i]
+                .iter()
+                .zip(&b[..i])
+                .map(|(a, x)| a * x)
+                .sum::<f64>();
+        b[i] = if row[i] > 0.0 { s / row[i] } else { 0.0 };
+    }
+    for i in (0..n).rev() {
+        let d = l[i * n + i];
+        if !(d > 0.0) {
+            b[i] = 0.0;
+            continue;
+        }
+        let x = b[i] / d;
+        b[i] = x;
+        // Lᵀ column by column: subtract this unknown from the rows above it.
+        for (k, bk) in b[..i].iter_mut().enumerate() {
+            *bk -= l[i * n + k] * x;
+        }
+    }
+}
+
+fn find(parent: &mut [u32], mut i: u32) -> u32 {
+    while parent[i as usize] != i {
+        let next = parent[parent[i as usize] as usize];
+        parent[i as usize] = next;
+        i = next;
+    }
+    i
+}
+
+/// Joins the sets of `a` and `b`, the lower root becoming the root (deterministic).
+fn union(parent: &mut [u32], a: u32, b: u32) {
+    let (ra, rb) = (find(parent, a), find(parent, b));
+    if ra != rb {
+        let (lo, hi) = (ra.min(rb), ra.max(rb));
+        parent[hi as usize] = lo;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_dependent_row_gets_no_impulse_and_the_others_meet_it() {
+        // Rows along x, y and x + y of one unit mass: J·Jᵀ has rank 2, like the rows of a face.
+        let mut a = [1.0, 0.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, 2.0];
+        assert!(cholesky_factor(&mut a, 3));
+        // Targets a motion can meet: the velocity (1, 2) gives 1, 2 and 3.
+        let mut b = [1.0, 2.0, 3.0];
+        cholesky_substitute(&a, &mut b, 3);
+        assert_eq!(b[2], 0.0);
+        assert!(
+            (b[0] - 1.0).abs() < 1e-12 && (b[1] - 2.0).abs() < 1e-12,
+            "{b:?}"
+        );
+    }
+
+    #[test]
+    fn a_positive_definite_system_is_solved_exactly() {
+        // A light body between a heavy one and the ground, 1:10,000: the ill-conditioned pair of
+        // rows Gauss-Seidel needs thousands of sweeps for.
+        let (light, heavy) = (1.0, 1e-4);
+        let mut a = [light, -light, -light, light + heavy];
+        let x = [3.0, 2.0];
+        let mut b = [a[0] * x[0] + a[1] * x[1], a[2] * x[0] + a[3] * x[1]];
+        assert!(cholesky_factor(&mut a, 2));
+        cholesky_substitute(&a, &mut b, 2);
+        assert!(
+            (b[0] - x[0]).abs() < 1e-9 && (b[1] - x[1]).abs() < 1e-9,
+            "{b:?}"
+        );
+    }
+
+    #[test]
+    fn a_non_finite_pivot_is_refused() {
+        let mut a = [f64::NAN, 0.0, 0.0, 1.0];
+        assert!(!cholesky_factor(&mut a, 2));
+    }
+}
