@@ -18,6 +18,7 @@ pub mod resolver;
 pub mod soft_step;
 pub mod solver_body;
 pub mod synthetic;
+mod union_find;
 
 pub use contact::Contact;
 pub use millington::{MillingtonResolver, MillingtonSettings};

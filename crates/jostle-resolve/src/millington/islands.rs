@@ -12,6 +12,7 @@
 
 use super::change::NO_BODY;
 use super::prepare::PreparedContact;
+use crate::union_find::UnionFind;
 
 /// Contacts grouped by island, and the adjacency of moving bodies, in CSR form.
 #[derive(Clone, Debug, Default)]
@@ -23,8 +24,8 @@ pub struct Islands {
     /// `adj_contacts[adj_starts[b]..adj_starts[b + 1]]` are the contacts touching body b.
     adj_starts: Vec<u32>,
     adj_contacts: Vec<u32>,
-    /// Union-find parent of each body (scratch).
-    parent: Vec<u32>,
+    /// Union-find over the bodies (scratch).
+    sets: UnionFind,
     /// Island of each union-find root, or `NO_BODY` (scratch).
     island_of_root: Vec<u32>,
     /// Island of each contact, or `NO_BODY` when it takes part in nothing (scratch).
@@ -38,14 +39,13 @@ impl Islands {
     /// Rebuilds islands and adjacency for `contacts` over `body_count` bodies. Contacts with
     /// no moving side belong to no island.
     pub fn build(&mut self, contacts: &[PreparedContact], body_count: usize) {
-        self.parent.clear();
-        self.parent.extend(0..body_count as u32);
+        self.sets.reset(body_count);
         for c in contacts {
             if let [a, b] = c.body
                 && a != NO_BODY
                 && b != NO_BODY
             {
-                self.union(a, b);
+                self.sets.union(a, b);
             }
         }
 
@@ -66,7 +66,7 @@ impl Islands {
                 self.island_of_contact.push(NO_BODY);
                 continue;
             }
-            let root = self.find(any) as usize;
+            let root = self.sets.find(any) as usize;
             if self.island_of_root[root] == NO_BODY {
                 self.island_of_root[root] = counts.len() as u32;
                 counts.push(0);
@@ -155,26 +155,6 @@ impl Islands {
             return &[];
         }
         &self.adj_contacts[self.adj_starts[b] as usize..self.adj_starts[b + 1] as usize]
-    }
-
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.parent[x as usize] != x {
-            // Path halving.
-            let grand = self.parent[self.parent[x as usize] as usize];
-            self.parent[x as usize] = grand;
-            x = grand;
-        }
-        x
-    }
-
-    fn union(&mut self, a: u32, b: u32) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        // Lower root wins: deterministic, and depth stays small with path halving.
-        if ra < rb {
-            self.parent[rb as usize] = ra;
-        } else if rb < ra {
-            self.parent[ra as usize] = rb;
-        }
     }
 }
 

@@ -44,6 +44,7 @@ use super::batch::{Batches, LANES, NO_SOURCE};
 use super::body_state::BodyState;
 use super::solve::{RowPass, RowState, row_residuals};
 use crate::STATIC_BODY;
+use crate::union_find::UnionFind;
 use jostle_math::Vec3;
 
 /// A pivot below this fraction of its row's diagonal marks the row as depending on the rows
@@ -130,7 +131,7 @@ pub struct DirectIslands {
     /// and the compliances do not change.
     factors: Vec<[Vec<Factor>; 2]>,
     // Scratch reused from step to step.
-    parent: Vec<u32>,
+    sets: UnionFind,
     row_count: Vec<u32>,
     mixed: Vec<bool>,
     island_of: Vec<u32>,
@@ -213,12 +214,11 @@ impl DirectIslands {
             return;
         }
         let movable = |i: u32| i != STATIC_BODY && states[i as usize].inv_mass > 0.0;
-        self.parent.clear();
-        self.parent.extend(0..states.len() as u32);
+        self.sets.reset(states.len());
         for m in &batches.manifolds {
             for l in 0..LANES {
                 if movable(m.a[l]) && movable(m.b[l]) {
-                    union(&mut self.parent, m.a[l], m.b[l]);
+                    self.sets.union(m.a[l], m.b[l]);
                 }
             }
         }
@@ -226,14 +226,14 @@ impl DirectIslands {
         self.row_count.resize(states.len(), 0);
         self.mixed.clear();
         self.mixed.resize(states.len(), false);
-        let root_of = |parent: &mut Vec<u32>, a: u32, b: u32| {
+        let root_of = |sets: &mut UnionFind, a: u32, b: u32| {
             let body = if movable(a) { a } else { b };
-            movable(body).then(|| find(parent, body))
+            movable(body).then(|| sets.find(body))
         };
         for m in &batches.manifolds {
             let points = &batches.sources[m.first as usize..(m.first + m.count) as usize];
             for l in 0..LANES {
-                let Some(root) = root_of(&mut self.parent, m.a[l], m.b[l]) else {
+                let Some(root) = root_of(&mut self.sets, m.a[l], m.b[l]) else {
                     continue;
                 };
                 let rows = points.iter().filter(|s| s[l] != NO_SOURCE).count() as u32;
@@ -249,7 +249,7 @@ impl DirectIslands {
         let mut islands = 0u32;
         for (bi, m) in batches.manifolds.iter().enumerate() {
             for l in 0..LANES {
-                let Some(root) = root_of(&mut self.parent, m.a[l], m.b[l]) else {
+                let Some(root) = root_of(&mut self.sets, m.a[l], m.b[l]) else {
                     continue;
                 };
                 let r = root as usize;
@@ -714,24 +714,6 @@ fn cholesky_substitute(l: &[f64], b: &mut [f64], n: usize) {
         for (k, bk) in b[..i].iter_mut().enumerate() {
             *bk -= l[i * n + k] * x;
         }
-    }
-}
-
-fn find(parent: &mut [u32], mut i: u32) -> u32 {
-    while parent[i as usize] != i {
-        let next = parent[parent[i as usize] as usize];
-        parent[i as usize] = next;
-        i = next;
-    }
-    i
-}
-
-/// Joins the sets of `a` and `b`, the lower root becoming the root (deterministic).
-fn union(parent: &mut [u32], a: u32, b: u32) {
-    let (ra, rb) = (find(parent, a), find(parent, b));
-    if ra != rb {
-        let (lo, hi) = (ra.min(rb), ra.max(rb));
-        parent[hi as usize] = lo;
     }
 }
 
