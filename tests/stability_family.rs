@@ -119,10 +119,17 @@ fn heavy_boxes_on_light_ones_stand() {
 
 #[test]
 fn perturbed_heavy_boxes_on_light_ones_stand() {
-    // Starts perturbed from seeds the family table does not use; the sweep of
+    // Starts perturbed from seeds the family table does not use, the heavy box landing on an
+    // edge of a light one: with friction left out of the biased pass's direct solve all four
+    // fell (the light box spun under the friction the relax pass had left on it). The sweep of
     // `FAMILY_SET=heavy` has the perturbed cases that still fall (benches/RESULTS.md, "Heavy
     // on light: a direct solve").
-    for (ratio, n, seed) in [(1000.0, 2, 3), (1000.0, 5, 4), (10000.0, 2, 3)] {
+    for (ratio, n, seed) in [
+        (1000.0, 2, 4),
+        (1000.0, 5, 3),
+        (10000.0, 2, 4),
+        (10000.0, 5, 4),
+    ] {
         let v = Variant {
             seed: Some(seed),
             ..Variant::default()
