@@ -155,7 +155,7 @@ pub struct SoftStepResolver {
     inv_inertia_now: Vec<Mat3>,
     /// Each point's response in the restitution pass ([`solve::restitution_response`]).
     response: Vec<solve::Response>,
-    /// The islands whose normal rows are solved directly this step ([`direct`]).
+    /// The islands whose contact rows are solved directly this step ([`direct`]).
     direct: direct::DirectIslands,
 }
 

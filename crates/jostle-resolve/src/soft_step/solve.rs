@@ -426,7 +426,7 @@ fn rigid_row<F: Lane>(
     -p.normal_mass * (vn + bias)
 }
 
-/// Which pass a [`row_residual`] is taken in.
+/// Which pass a row of [`row_residuals`] is taken in.
 #[derive(Clone, Copy, Debug)]
 pub enum RowPass {
     /// The biased pass ([`solve`]) with these parameters.
@@ -810,7 +810,7 @@ fn solve_impl<F: Lane>(
 }
 
 wide_kernel! {
-    /// One biased pass with split impulses ([`solve_batch_split`]): every contact with its
+    /// One biased pass with split impulses (`solve_batch_split`): every contact with its
     /// own softness, the push-out of overlap beyond the load's (and beyond the allowance of
     /// resting contacts; at most `max_push_out`, m/s) in the pseudo velocities `pseudo` (one
     /// [`PseudoRow`] per body, zero at the start of the pass), with friction when
