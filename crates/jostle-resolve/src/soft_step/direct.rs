@@ -130,10 +130,9 @@ pub struct DirectIslands {
     /// Each island's (J·M⁻¹·Jᵀ)ᵢⱼ over all its rows (row-major), one island after another:
     /// the rows do not change within a step.
     couplings: Vec<f64>,
-    /// Each island's last [`FACTORS`] factorisations of each pass kind (biased, relax),
-    /// reused while its free rows are the same as one of them: within a step the couplings
-    /// and the compliances do not change.
-    factors: Vec<[Vec<Factor>; 2]>,
+    /// Each island's last factorisation for each pass kind (biased, relax), reused while its
+    /// free rows stay the same: within a step the couplings and the compliances do not change.
+    factors: Vec<[Factor; 2]>,
     // Scratch reused from step to step.
     sets: UnionFind,
     row_count: Vec<u32>,
@@ -142,19 +141,12 @@ pub struct DirectIslands {
     solver: Solver,
 }
 
-/// A Cholesky factor of an island's system over the free rows `index`, last used in round
-/// `used` of the step.
+/// A Cholesky factor of an island's system over the free rows `index` (empty: none yet).
 #[derive(Clone, Debug, Default)]
 struct Factor {
     index: Vec<usize>,
     matrix: Vec<f64>,
-    used: u64,
 }
-
-/// Factorisations kept per island and pass kind: the active set of a resting island
-/// alternates between a few free sets (all rows, then those left after fixing pulling or
-/// sliding ones), each met again in every substep.
-const FACTORS: usize = 4;
 
 /// The dense solve of one island at a time, with its scratch.
 #[derive(Clone, Debug, Default)]
@@ -171,8 +163,6 @@ struct Solver {
     change: Vec<f64>,
     /// The free rows, in order.
     index: Vec<usize>,
-    /// Solves so far, for the factorisations' last use.
-    round: u64,
 }
 
 /// A row's part in an island's solve.
@@ -191,11 +181,6 @@ enum Role {
 const NONE: u32 = u32::MAX;
 
 impl DirectIslands {
-    /// Number of islands solved directly this step.
-    pub fn len(&self) -> usize {
-        self.islands.len()
-    }
-
     /// Whether no island is solved directly this step.
     pub fn is_empty(&self) -> bool {
         self.islands.is_empty()
@@ -318,8 +303,8 @@ impl DirectIslands {
         self.factors
             .resize_with(self.islands.len(), Default::default);
         for factors in &mut self.factors {
-            for kind in factors {
-                kind.clear();
+            for factor in factors {
+                factor.index.clear();
             }
         }
     }
@@ -369,8 +354,8 @@ impl DirectIslands {
         }
     }
 
-    /// Solves every direct island's normal rows as `pass` states them, and applies the
-    /// result to `states` and to the accumulated impulses in `batches`.
+    /// Solves every direct island's rows (normal and friction) as `pass` states them, and
+    /// applies the result to `states` and to the accumulated impulses in `batches`.
     pub fn correct(&mut self, batches: &mut Batches, states: &mut [BodyState], pass: RowPass) {
         let kind = match pass {
             RowPass::Biased(_) => 0,
@@ -381,9 +366,9 @@ impl DirectIslands {
             let rows = &self.rows[start as usize..end as usize];
             let couplings = &self.couplings[offset..offset + rows.len() * rows.len()];
             offset += rows.len() * rows.len();
-            let factors = &mut self.factors[island][kind];
+            let factor = &mut self.factors[island][kind];
             self.solver
-                .solve_island(batches, states, rows, couplings, factors, pass);
+                .solve_island(batches, states, rows, couplings, factor, pass);
         }
     }
 }
@@ -402,7 +387,7 @@ impl Solver {
         states: &mut [BodyState],
         rows: &[Row],
         couplings: &[f64],
-        factors: &mut Vec<Factor>,
+        factor: &mut Factor,
         pass: RowPass,
     ) {
         let relax = matches!(pass, RowPass::Relax { .. });
@@ -451,7 +436,7 @@ impl Solver {
             self.change.push(0.0);
         }
         for _ in 0..ACTIVE_SET_ROUNDS {
-            if !self.solve_free(couplings, factors) {
+            if !self.solve_free(couplings, factor) {
                 return;
             }
             if !self.fix_pulling_rows(rows) && !self.fix_sliding_points(rows, batches) {
@@ -468,9 +453,9 @@ impl Solver {
 
     /// Solves (J·M⁻¹·Jᵀ + C)·x = r over the free rows, the fixed rows' changes moved to the
     /// right-hand side; the changes go to [`Solver::change`]. `couplings` is J·M⁻¹·Jᵀ over
-    /// all the island's rows; a factorisation of `factors` with the same free rows is reused.
+    /// all the island's rows; `factor` is factorised again only when the free rows changed.
     /// False when there is nothing to solve or the factorisation fails.
-    fn solve_free(&mut self, couplings: &[f64], factors: &mut Vec<Factor>) -> bool {
+    fn solve_free(&mut self, couplings: &[f64], factor: &mut Factor) -> bool {
         let all = self.role.len();
         self.index.clear();
         self.index
@@ -479,38 +464,21 @@ impl Solver {
         if n == 0 {
             return self.role.contains(&Role::Fixed);
         }
-        self.round += 1;
-        let found = factors.iter().position(|f| f.index == self.index);
-        let slot = match found {
-            Some(slot) => slot,
-            None => {
-                let slot = if factors.len() < FACTORS {
-                    factors.push(Factor::default());
-                    factors.len() - 1
-                } else {
-                    (0..factors.len())
-                        .min_by_key(|&k| factors[k].used)
-                        .unwrap_or(0)
-                };
-                let factor = &mut factors[slot];
-                factor.index.clone_from(&self.index);
-                factor.matrix.clear();
-                factor.matrix.resize(n * n, 0.0);
-                for (i, &ri) in self.index.iter().enumerate() {
-                    for (j, &rj) in self.index.iter().enumerate().take(i + 1) {
-                        factor.matrix[i * n + j] = couplings[ri * all + rj];
-                    }
-                    factor.matrix[i * n + i] += f64::from(self.residual[ri].compliance);
+        if factor.index != self.index {
+            factor.index.clone_from(&self.index);
+            factor.matrix.clear();
+            factor.matrix.resize(n * n, 0.0);
+            for (i, &ri) in self.index.iter().enumerate() {
+                for (j, &rj) in self.index.iter().enumerate().take(i + 1) {
+                    factor.matrix[i * n + j] = couplings[ri * all + rj];
                 }
-                if !cholesky_factor(&mut factor.matrix, n) {
-                    factor.index.clear();
-                    return false;
-                }
-                slot
+                factor.matrix[i * n + i] += f64::from(self.residual[ri].compliance);
             }
-        };
-        factors[slot].used = self.round;
-        let factor = &factors[slot];
+            if !cholesky_factor(&mut factor.matrix, n) {
+                factor.index.clear();
+                return false;
+            }
+        }
         self.rhs.clear();
         self.rhs
             .extend(self.index.iter().map(|&ri| f64::from(self.residual[ri].r)));
