@@ -163,7 +163,8 @@ fn a_stack_of_15_boxes_stands_for_20_s_at_the_default_settings() {
 /// (`SoftStepSettings::direct_rows`) the soft contacts, springs scaled by the light box's
 /// effective mass, settled deep under the heavy box's load: the light box was squeezed into the
 /// ground, the heavy box sank into it, tipped and slid off (the scene declared 24 substeps at
-/// 180 Hz to stand, 9.6 mm low). With `direct_rows: 0` it falls again.
+/// 180 Hz to stand, 9.6 mm low). With `direct_rows: 0` it fails again: after 10 s the heavy
+/// box is 71 mm low and tilted, the light box has slid 0.14 m.
 #[test]
 fn a_light_box_under_a_1000_times_heavier_one_neither_sinks_nor_tips() {
     light_box_under_heavy_box(None);
