@@ -42,6 +42,7 @@ pub use jostle_collide::{
     BodyContact, CollideSettings, CollisionEvent, DisplayMesh, Material, RayHit, ShapeDesc,
 };
 pub use jostle_math::{Mat3, Quat, Vec3};
+pub use jostle_resolve::soft_step::team::set_threads;
 pub use jostle_resolve::{
     MillingtonResolver, MillingtonSettings, Resolver, SoftStepResolver, SoftStepSettings,
 };

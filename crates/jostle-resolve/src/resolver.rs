@@ -31,6 +31,9 @@ pub struct ResolveStats {
     pub velocity_iterations: u32,
     /// Independent contact islands solved.
     pub islands: u32,
+    /// Threads that could take part in the step (the soft step's team, 1 when it ran alone;
+    /// helpers busy with another world's step may have joined late or not at all).
+    pub threads: u32,
 }
 
 /// A contact resolver: advances the awake bodies by one step of `dt`, resolving the given

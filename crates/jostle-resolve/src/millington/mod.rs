@@ -259,6 +259,7 @@ impl Resolver for MillingtonResolver {
         let start = Instant::now();
         integrate_positions(bodies, ctx.dt);
         stats.integrate_time = velocities_time + start.elapsed();
+        stats.threads = 1;
         stats
     }
 }

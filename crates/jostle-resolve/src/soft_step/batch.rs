@@ -130,6 +130,11 @@ pub struct Batches {
     pub colours: u32,
     /// Manifolds that found no free colour and were given a batch of their own.
     pub overflow: u32,
+    /// Where each group of batches that write disjoint bodies starts in `manifolds` (one
+    /// group per colour, then one per overflow batch), and `manifolds.len()` last: group g is
+    /// `groups[g]..groups[g + 1]`. The batches of a group may be solved in any order, or at
+    /// once, with the same result.
+    pub groups: Vec<u32>,
     /// Contact points packed (lanes holding a contact).
     pub contacts: u32,
     /// Whether any packed contact has restitution (e > 0).
@@ -256,10 +261,38 @@ impl Batches {
             *slot += 1;
         }
 
+        // Within a colour, by body: the lower movable body's index, then input order. The
+        // threads of a step's team each take a contiguous part of every colour
+        // ([`super::team`]), so each keeps touching about the same bodies from colour to
+        // colour, and the body states stay in its core's cache.
+        let key = |r: &Run| {
+            let c = &contacts[kept[r.start as usize] as usize];
+            let body = match (c.a, c.b) {
+                (STATIC_BODY, b) => b,
+                (a, STATIC_BODY) => a,
+                (a, b) => a.min(b),
+            };
+            (u64::from(body) << 32) | u64::from(r.start)
+        };
+        // (`counts[c]` now ends colour c.)
+        let mut begin = 0;
+        for &end in counts.iter().take(COLOURS as usize) {
+            let runs = &self.runs;
+            self.order[begin as usize..end as usize]
+                .sort_unstable_by_key(|&i| key(&runs[i as usize]));
+            begin = end;
+        }
+
         // Pack: eight runs of one colour per batch; an overflow run alone.
+        self.groups.clear();
         let mut k = 0;
+        let mut group_colour = None;
         while k < self.order.len() {
             let colour = self.runs[self.order[k] as usize].colour;
+            if group_colour != Some(colour) || colour >= COLOURS {
+                self.groups.push(self.manifolds.len() as u32);
+                group_colour = Some(colour);
+            }
             let mut lanes = 1;
             if colour < COLOURS {
                 while lanes < LANES
@@ -276,6 +309,7 @@ impl Batches {
             self.push_batch(&batch_runs[..lanes], contacts);
             k += lanes;
         }
+        self.groups.push(self.manifolds.len() as u32);
         self.points
             .resize(self.sources.len(), PointLanes::default());
         prepare_batches(

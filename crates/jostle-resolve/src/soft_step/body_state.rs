@@ -20,7 +20,7 @@ pub type PseudoRow = [f32; 8];
 
 /// Hot state of one body during a soft step.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C)]
+#[repr(C, align(64))]
 pub struct BodyState {
     /// Linear velocity (m/s).
     pub linear_velocity: Vec3,

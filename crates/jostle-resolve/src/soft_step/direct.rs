@@ -44,8 +44,9 @@
 //! step for a pair, 0.17 ms for a light column of five under a heavy box (0.01 ms each
 //! without).
 
-use super::batch::{Batches, LANES, NO_SOURCE};
+use super::batch::{Batches, LANES, ManifoldLanes, NO_SOURCE, PointLanes};
 use super::body_state::BodyState;
+use super::shared::share;
 use super::solve::{RowPass, RowState, row_residuals};
 use crate::STATIC_BODY;
 use crate::union_find::UnionFind;
@@ -355,8 +356,15 @@ impl DirectIslands {
     }
 
     /// Solves every direct island's rows (normal and friction) as `pass` states them, and
-    /// applies the result to `states` and to the accumulated impulses in `batches`.
-    pub fn correct(&mut self, batches: &mut Batches, states: &mut [BodyState], pass: RowPass) {
+    /// applies the result to `states` and to the accumulated impulses in `points`, the points
+    /// of the batches `manifolds` ([`Batches::points`], [`Batches::manifolds`]).
+    pub fn correct(
+        &mut self,
+        manifolds: &[ManifoldLanes],
+        points: &mut [PointLanes],
+        states: &mut [BodyState],
+        pass: RowPass,
+    ) {
         let kind = match pass {
             RowPass::Biased(_) => 0,
             RowPass::Relax { .. } => 1,
@@ -368,7 +376,7 @@ impl DirectIslands {
             offset += rows.len() * rows.len();
             let factor = &mut self.factors[island][kind];
             self.solver
-                .solve_island(batches, states, rows, couplings, factor, pass);
+                .solve_island(manifolds, points, states, rows, couplings, factor, pass);
         }
     }
 }
@@ -381,9 +389,11 @@ impl Solver {
     /// point whose friction would leave its disk has it fixed on the disk, and the rest is
     /// solved again, for at most [`ACTIVE_SET_ROUNDS`] rounds; an island whose rounds run out
     /// is left to Gauss-Seidel.
+    #[allow(clippy::too_many_arguments)]
     fn solve_island(
         &mut self,
-        batches: &mut Batches,
+        manifolds: &[ManifoldLanes],
+        points: &mut [PointLanes],
         states: &mut [BodyState],
         rows: &[Row],
         couplings: &[f64],
@@ -397,12 +407,13 @@ impl Solver {
         self.change.clear();
         for (i, row) in rows.iter().enumerate() {
             let l = row.lane as usize;
-            let p = &batches.points[row.point as usize];
+            let p = &points[row.point as usize];
             let (residual, impulse, role) = match row.kind {
                 NORMAL => {
                     let row = row_residuals(
-                        batches,
-                        states,
+                        manifolds,
+                        points,
+                        share(states),
                         row.batch as usize,
                         row.point as usize,
                         pass,
@@ -439,13 +450,13 @@ impl Solver {
             if !self.solve_free(couplings, factor) {
                 return;
             }
-            if !self.fix_pulling_rows(rows) && !self.fix_sliding_points(rows, batches) {
+            if !self.fix_pulling_rows(rows) && !self.fix_sliding_points(rows, points) {
                 // The relax pass only takes velocity out; a solution whose fixed rows (the
                 // friction cone's, above all) would put kinetic energy in is not applied.
                 if relax && self.energy_change(rows, couplings, states) > 0.0 {
                     return;
                 }
-                self.apply(rows, batches, states);
+                self.apply(rows, points, states);
                 return;
             }
         }
@@ -544,13 +555,13 @@ impl Solver {
 
     /// Fixes the friction of every point whose sticking friction would leave its disk (μ
     /// times its normal impulse) on the disk, in the direction it asked for; true when any was.
-    fn fix_sliding_points(&mut self, rows: &[Row], batches: &Batches) -> bool {
+    fn fix_sliding_points(&mut self, rows: &[Row], points: &[PointLanes]) -> bool {
         let mut any = false;
         for (i, row) in rows.iter().enumerate() {
             if row.kind != TANGENT_1 || self.role[i] != Role::Free {
                 continue;
             }
-            let mu = f64::from(batches.points[row.point as usize].friction[row.lane as usize]);
+            let mu = f64::from(points[row.point as usize].friction[row.lane as usize]);
             let limit = mu * self.total(i - 1).max(0.0);
             let (t1, t2) = (self.total(i), self.total(i + 1));
             let length = (t1 * t1 + t2 * t2).sqrt();
@@ -568,13 +579,13 @@ impl Solver {
 
     /// Applies the changes of the free and fixed rows to the accumulated impulses and to the
     /// bodies.
-    fn apply(&self, rows: &[Row], batches: &mut Batches, states: &mut [BodyState]) {
+    fn apply(&self, rows: &[Row], points: &mut [PointLanes], states: &mut [BodyState]) {
         for (i, row) in rows.iter().enumerate() {
             if self.role[i] == Role::Out {
                 continue;
             }
             let l = row.lane as usize;
-            let p = &mut batches.points[row.point as usize];
+            let p = &mut points[row.point as usize];
             let total = self.total(i) as f32;
             let slot = match row.kind {
                 NORMAL => &mut p.normal_impulse[l],

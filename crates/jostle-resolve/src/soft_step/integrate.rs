@@ -11,8 +11,14 @@ use jostle_math::{Mat3, Quat, Vec3, integrate_orientation};
 
 /// v ← v + g·h for every body with mass; no angular change.
 pub fn integrate_velocities(states: &mut [BodyState], gravity: Vec3, h: f32) {
+    let start = (STATIC_BODY as usize + 1).min(states.len());
+    integrate_velocities_of(&mut states[start..], gravity, h);
+}
+
+/// [`integrate_velocities`] for every body of `states` (none of them the static entry).
+pub fn integrate_velocities_of(states: &mut [BodyState], gravity: Vec3, h: f32) {
     let dv = gravity * h;
-    for s in states.iter_mut().skip(STATIC_BODY as usize + 1) {
+    for s in states.iter_mut() {
         if s.inv_mass > 0.0 {
             s.linear_velocity += dv;
         }
@@ -36,9 +42,21 @@ pub fn integrate_velocities_gyroscopic(
     h: f32,
 ) {
     debug_assert_eq!(states.len(), inertia.len());
+    let start = (STATIC_BODY as usize + 1).min(states.len());
+    integrate_velocities_gyroscopic_of(&mut states[start..], &inertia[start..], gravity, h);
+}
+
+/// [`integrate_velocities_gyroscopic`] for every body of `states` (none of them the static
+/// entry), `inertia` theirs.
+pub fn integrate_velocities_gyroscopic_of(
+    states: &mut [BodyState],
+    inertia: &[Mat3],
+    gravity: Vec3,
+    h: f32,
+) {
+    debug_assert_eq!(states.len(), inertia.len());
     let dv = gravity * h;
-    let start = STATIC_BODY as usize + 1;
-    for (s, &i0) in states.iter_mut().zip(inertia).skip(start) {
+    for (s, &i0) in states.iter_mut().zip(inertia) {
         if s.inv_mass > 0.0 {
             s.linear_velocity += dv;
         }
@@ -63,8 +81,15 @@ pub fn integrate_velocities_gyroscopic(
 /// 10 rad/s pushed out of the floor gained 2.8% of its energy that way).
 pub fn integrate_positions(states: &mut [BodyState], pseudo: &mut [PseudoRow], h: f32) {
     debug_assert_eq!(states.len(), pseudo.len());
-    let start = STATIC_BODY as usize + 1;
-    for (s, p) in states.iter_mut().zip(pseudo.iter_mut()).skip(start) {
+    let start = (STATIC_BODY as usize + 1).min(states.len());
+    integrate_positions_of(&mut states[start..], &mut pseudo[start..], h);
+}
+
+/// [`integrate_positions`] for every body of `states` (none of them the static entry),
+/// `pseudo` theirs.
+pub fn integrate_positions_of(states: &mut [BodyState], pseudo: &mut [PseudoRow], h: f32) {
+    debug_assert_eq!(states.len(), pseudo.len());
+    for (s, p) in states.iter_mut().zip(pseudo.iter_mut()) {
         let linear = Vec3::new(p[0], p[1], p[2]);
         let angular = Vec3::new(p[4], p[5], p[6]);
         *p = [0.0; 8];

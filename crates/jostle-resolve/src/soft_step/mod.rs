@@ -119,8 +119,10 @@ pub mod lanes;
 mod lanes_avx;
 pub mod prepare;
 pub mod settings;
+pub mod shared;
 pub mod softness;
 pub mod solve;
+pub mod team;
 
 pub use batch::Batches;
 pub use body_state::{BodyState, PseudoRow};
@@ -129,8 +131,12 @@ pub use settings::SoftStepSettings;
 pub use softness::Softness;
 
 use crate::{Contact, ResolveStats, Resolver, STATIC_BODY, SolverBody, StepContext};
-use jostle_math::Mat3;
+use batch::{ManifoldLanes, PointLanes};
+use jostle_math::{Mat3, Vec3};
+use shared::{Shared, share, share_one, slice_mut};
+use std::cell::Cell;
 use std::time::{Duration, Instant};
+use team::{Crew, Plan, Solo, Team};
 
 /// The soft-step resolver (see the module docs). Holds its settings and scratch buffers
 /// reused from step to step; its only memory between steps is the contacts' impulses, which
@@ -157,6 +163,12 @@ pub struct SoftStepResolver {
     response: Vec<solve::Response>,
     /// The islands whose contact rows are solved directly this step ([`direct`]).
     direct: direct::DirectIslands,
+    /// The threads of the substeps ([`team`]) and the stages they run.
+    team: Team,
+    plan: Vec<team::Parts>,
+    /// Scratch of [`owner_bounds`], and its result.
+    owners: Vec<u32>,
+    bounds: Vec<u32>,
 }
 
 impl SoftStepResolver {
@@ -344,6 +356,220 @@ fn preload_update(manifold: solve::ManifoldEnd, rate: f32, target: f32, dt: f32)
     preload.min(manifold.compression).max(0.0)
 }
 
+/// Fewest batches for which a step's substeps run on more than one thread: below, the
+/// stages are too short for the threads' hand-overs to pay.
+pub const PARALLEL_MIN_BATCHES: usize = 128;
+
+/// Batches per item of a team's stage ([`team`]).
+const TEAM_BATCH_CHUNK: u32 = 2;
+
+/// Bodies per item of a team's integration stages.
+const TEAM_BODY_CHUNK: u32 = 16;
+
+/// Wall time per kind of stage, as one thread saw it: integration, the biased pass (with
+/// the warm start and its direct solve), the relax pass (with its direct solve).
+#[derive(Default)]
+struct Timing([Cell<Duration>; 3]);
+
+impl Timing {
+    const INTEGRATE: usize = 0;
+    const SOLVE: usize = 1;
+    const RELAX: usize = 2;
+
+    /// Runs `f`, adding its wall time to `kind`.
+    fn time(&self, kind: usize, f: impl FnOnce()) {
+        let t = Instant::now();
+        f();
+        let cell = &self.0[kind];
+        cell.set(cell.get() + t.elapsed());
+    }
+
+    fn get(&self) -> [Duration; 3] {
+        [self.0[0].get(), self.0[1].get(), self.0[2].get()]
+    }
+}
+
+/// The body whose thread should solve batch `m` ([`team::Plan`]): its first manifold's
+/// lower movable body. [`Batches::pack`] orders each colour's manifolds by it.
+fn batch_owner(m: &ManifoldLanes) -> u32 {
+    match (m.a[0], m.b[0]) {
+        (STATIC_BODY, b) => b,
+        (a, STATIC_BODY) => a,
+        (a, b) => a.min(b),
+    }
+}
+
+/// The first body of each thread's range but the first's, for `threads` threads: the
+/// owners ([`batch_owner`]) that split the batches into equal shares.
+fn owner_bounds(
+    manifolds: &[ManifoldLanes],
+    threads: usize,
+    scratch: &mut Vec<u32>,
+    bounds: &mut Vec<u32>,
+) {
+    scratch.clear();
+    scratch.extend(manifolds.iter().map(batch_owner));
+    scratch.sort_unstable();
+    bounds.clear();
+    bounds.extend((1..threads).map(|t| {
+        scratch
+            .get(scratch.len() * t / threads)
+            .copied()
+            .unwrap_or(u32::MAX)
+    }));
+}
+
+/// Everything the substeps of one step read and write, shared by the threads that run them
+/// ([`team`]); every access to a shared element follows the contract of [`shared`]: within a
+/// stage, items write disjoint batches and bodies.
+struct Substeps<'a> {
+    manifolds: &'a [Shared<ManifoldLanes>],
+    points: &'a [Shared<PointLanes>],
+    /// [`Batches::groups`].
+    groups: &'a [u32],
+    states: &'a [Shared<BodyState>],
+    pseudo: &'a [Shared<PseudoRow>],
+    inertia: &'a [Mat3],
+    gyroscopic: bool,
+    direct: &'a Shared<direct::DirectIslands>,
+    direct_live: bool,
+    gravity: Vec3,
+    h: f32,
+    inv_h: f32,
+    substeps: u32,
+    relax_iterations: u32,
+    pass: solve::BiasedPass,
+    sweeps: u32,
+    /// Batches per stage item (`u32::MAX`: a whole group).
+    batch_chunk: u32,
+    /// Bodies per stage item (`u32::MAX`: all).
+    body_chunk: u32,
+}
+
+impl Substeps<'_> {
+    /// The substeps, stage by stage on `crew`.
+    fn run(&self, crew: &impl Crew, timing: &Timing) {
+        for _ in 0..self.substeps {
+            timing.time(Timing::INTEGRATE, || {
+                self.each_body_range(crew, |states, first| {
+                    if self.gyroscopic {
+                        let inertia = &self.inertia[first..first + states.len()];
+                        integrate::integrate_velocities_gyroscopic_of(
+                            states,
+                            inertia,
+                            self.gravity,
+                            self.h,
+                        );
+                    } else {
+                        integrate::integrate_velocities_of(states, self.gravity, self.h);
+                    }
+                });
+            });
+            timing.time(Timing::SOLVE, || {
+                self.each_batch_range(crew, |m, p, base| {
+                    solve::warm_start_range(m, p, base, self.states);
+                });
+                self.each_batch_range(crew, |m, p, base| {
+                    solve::solve_range(m, p, base, self.states, self.pseudo, self.pass);
+                });
+                self.direct_correct(crew, solve::RowPass::Biased(self.pass));
+            });
+            timing.time(Timing::INTEGRATE, || {
+                self.each_body_range(crew, |states, first| {
+                    // SAFETY: the body ranges of a stage are disjoint (as for `states`).
+                    let pseudo = unsafe { slice_mut(self.pseudo, first..first + states.len()) };
+                    integrate::integrate_positions_of(states, pseudo, self.h);
+                });
+            });
+            timing.time(Timing::RELAX, || {
+                for _ in 0..self.relax_iterations {
+                    self.each_batch_range(crew, |m, p, base| {
+                        solve::relax_range(m, p, base, self.states, self.inv_h, self.sweeps);
+                    });
+                    self.direct_correct(crew, solve::RowPass::Relax { inv_h: self.inv_h });
+                }
+            });
+        }
+    }
+
+    /// One stage per group of batches ([`Batches::groups`]), each item `f(manifolds,
+    /// points, base)` on a run of the group's batches, their points and the index of the
+    /// first.
+    fn each_batch_range(
+        &self,
+        crew: &impl Crew,
+        f: impl Fn(&mut [ManifoldLanes], &mut [PointLanes], u32),
+    ) {
+        for group in self.groups.windows(2) {
+            let (start, end) = (group[0], group[1]);
+            let items = (end - start).div_ceil(self.batch_chunk);
+            let owner = |i: u32| {
+                // SAFETY: the batches are only read during the substeps' stages... (the
+                // planning pass runs before any thread starts).
+                batch_owner(unsafe {
+                    self.manifolds[(start + i * self.batch_chunk) as usize].get()
+                })
+            };
+            crew.stage(items, owner, |i| {
+                let first = start + i * self.batch_chunk;
+                let last = first.saturating_add(self.batch_chunk).min(end);
+                // SAFETY: the items of a stage are disjoint runs of one group's batches, whose
+                // points are disjoint too; the batches of a group write disjoint bodies.
+                let manifolds = unsafe { slice_mut(self.manifolds, first as usize..last as usize) };
+                let (Some(m0), Some(m1)) = (manifolds.first(), manifolds.last()) else {
+                    return;
+                };
+                let (p0, p1) = (m0.first, m1.first + m1.count);
+                // SAFETY: as above.
+                let points = unsafe { slice_mut(self.points, p0 as usize..p1 as usize) };
+                f(manifolds, points, p0);
+            });
+        }
+    }
+
+    /// One stage over the bodies (the static entry left out), each item `f(states, first)`
+    /// on a run of body states, `first` the index of the run's first.
+    fn each_body_range(&self, crew: &impl Crew, f: impl Fn(&mut [BodyState], usize)) {
+        let start = (STATIC_BODY as usize + 1).min(self.states.len()) as u32;
+        let end = self.states.len() as u32;
+        let items = (end - start).div_ceil(self.body_chunk);
+        crew.stage(
+            items,
+            |i| start + i * self.body_chunk,
+            |i| {
+                let first = start + i * self.body_chunk;
+                let last = first.saturating_add(self.body_chunk).min(end);
+                // SAFETY: the items of a stage are disjoint runs of bodies.
+                let states = unsafe { slice_mut(self.states, first as usize..last as usize) };
+                f(states, first as usize);
+            },
+        );
+    }
+
+    /// The direct solve ([`direct`]) after a pass, as a stage of one item.
+    fn direct_correct(&self, crew: &impl Crew, pass: solve::RowPass) {
+        if !self.direct_live {
+            return;
+        }
+        crew.stage(
+            1,
+            |_| 0,
+            |_| {
+                // SAFETY: a stage of one item: no other thread touches anything meanwhile.
+                let (direct, manifolds, points, states) = unsafe {
+                    (
+                        self.direct.get_mut(),
+                        slice_mut(self.manifolds, 0..self.manifolds.len()),
+                        slice_mut(self.points, 0..self.points.len()),
+                        slice_mut(self.states, 0..self.states.len()),
+                    )
+                };
+                direct.correct(manifolds, points, states, pass);
+            },
+        );
+    }
+}
+
 impl Resolver for SoftStepResolver {
     fn name(&self) -> &'static str {
         "soft-step"
@@ -384,9 +610,6 @@ impl Resolver for SoftStepResolver {
             .stiffen(&mut self.batches, ctx.gravity.length() * h);
         stats.prepare_time = start.elapsed();
 
-        let mut integrate_time = Duration::ZERO;
-        let mut solve_time = Duration::ZERO;
-        let mut relax_time = Duration::ZERO;
         let push_out = self.settings.max_push_out;
         let rigid = self.settings.rigid_contacts;
         let sweeps = if rigid {
@@ -394,66 +617,101 @@ impl Resolver for SoftStepResolver {
         } else {
             1
         };
-        for _ in 0..substeps {
-            let t = Instant::now();
-            if self.settings.gyroscopic {
-                integrate::integrate_velocities_gyroscopic(
-                    &mut self.states,
-                    &self.inertia,
-                    ctx.gravity,
-                    h,
-                );
+        let pass = solve::BiasedPass {
+            inv_h,
+            max_push_out: push_out,
+            slop: if rigid {
+                self.settings.rigid_slop
             } else {
-                integrate::integrate_velocities(&mut self.states, ctx.gravity, h);
-            }
-            integrate_time += t.elapsed();
-
-            let t = Instant::now();
-            solve::warm_start(&mut self.batches, &mut self.states);
-            let pass = solve::BiasedPass {
-                inv_h,
-                max_push_out: push_out,
-                slop: if rigid {
-                    self.settings.rigid_slop
-                } else {
-                    self.settings.push_out_slop
-                },
-                resting_speed: self.settings.restitution_threshold,
-                gravity_speed: ctx.gravity.length() * h,
-                friction: self.settings.friction_in_bias_pass
-                    || self.settings.relax_iterations == 0
-                    || rigid,
-                rigid,
-                sweeps,
-                rate: self.settings.push_out_rate * inv_h,
-            };
-            solve::solve(&mut self.batches, &mut self.states, &mut self.pseudo, pass);
-            if !self.direct.is_empty() {
-                self.direct.correct(
-                    &mut self.batches,
-                    &mut self.states,
-                    solve::RowPass::Biased(pass),
-                );
-            }
-            solve_time += t.elapsed();
-
-            let t = Instant::now();
-            integrate::integrate_positions(&mut self.states, &mut self.pseudo, h);
-            integrate_time += t.elapsed();
-
-            let t = Instant::now();
-            for _ in 0..self.settings.relax_iterations {
-                solve::relax(&mut self.batches, &mut self.states, inv_h, sweeps);
-                if !self.direct.is_empty() {
-                    self.direct.correct(
-                        &mut self.batches,
-                        &mut self.states,
-                        solve::RowPass::Relax { inv_h },
-                    );
-                }
-            }
-            relax_time += t.elapsed();
+                self.settings.push_out_slop
+            },
+            resting_speed: self.settings.restitution_threshold,
+            gravity_speed: ctx.gravity.length() * h,
+            friction: self.settings.friction_in_bias_pass
+                || self.settings.relax_iterations == 0
+                || rigid,
+            rigid,
+            sweeps,
+            rate: self.settings.push_out_rate * inv_h,
+        };
+        let threads = if self.batches.manifolds.len() >= PARALLEL_MIN_BATCHES {
+            team::available_threads()
+        } else {
+            1
+        };
+        let direct_live = !self.direct.is_empty();
+        if threads > 1 {
+            owner_bounds(
+                &self.batches.manifolds,
+                threads,
+                &mut self.owners,
+                &mut self.bounds,
+            );
         }
+        let times = {
+            let Batches {
+                manifolds,
+                points,
+                groups,
+                ..
+            } = &mut self.batches;
+            let work = Substeps {
+                manifolds: share(manifolds),
+                points: share(points),
+                groups,
+                states: share(&mut self.states),
+                pseudo: share(&mut self.pseudo),
+                inertia: &self.inertia,
+                gyroscopic: self.settings.gyroscopic,
+                direct: share_one(&mut self.direct),
+                direct_live,
+                gravity: ctx.gravity,
+                h,
+                inv_h,
+                substeps,
+                relax_iterations: self.settings.relax_iterations,
+                pass,
+                sweeps,
+                batch_chunk: if threads > 1 {
+                    TEAM_BATCH_CHUNK
+                } else {
+                    u32::MAX
+                },
+                body_chunk: if threads > 1 {
+                    TEAM_BODY_CHUNK
+                } else {
+                    u32::MAX
+                },
+            };
+            if threads > 1 {
+                let plan = Plan {
+                    bounds: &self.bounds,
+                    stages: Default::default(),
+                };
+                work.run(&plan, &Timing::default());
+                self.plan.clear();
+                self.plan.append(&mut plan.stages.borrow_mut());
+                self.team.reset(threads, &self.plan);
+                // The first thread's times: each stage's wall time, waits included.
+                let times = std::sync::Mutex::new([Duration::ZERO; 3]);
+                team::run(&self.team, |member| {
+                    let timing = Timing::default();
+                    work.run(member, &timing);
+                    if member.id() == 0
+                        && let Ok(mut t) = times.lock()
+                    {
+                        *t = timing.get();
+                    }
+                });
+                times.into_inner().unwrap_or_default()
+            } else {
+                let timing = Timing::default();
+                work.run(&Solo, &timing);
+                timing.get()
+            }
+        };
+        let [integrate_time, solve_time, mut relax_time] = times;
+        stats.threads = threads as u32;
         let t = Instant::now();
         let threshold = self.settings.restitution_threshold;
         if any_restitution && solve::any_bounces(&self.batches, threshold) {
@@ -511,7 +769,7 @@ impl Resolver for SoftStepResolver {
         let (rate, target) = (self.settings.preload_rate, self.settings.preload_target);
         solve::results(
             &self.batches,
-            &self.states,
+            &mut self.states,
             |i, impulse, separation, manifold| {
                 let c = &mut contacts[i as usize];
                 c.impulse = impulse * substeps as f32;

@@ -21,6 +21,7 @@
 use super::batch::{Batches, LANES, MAX_POINTS, ManifoldLanes, PointLanes};
 use super::body_state::{BodyState, PseudoRow};
 use super::lanes::{F8, Lane, LaneMask, Q8, V3x8};
+use super::shared::{Shared, share};
 use crate::STATIC_BODY;
 use jostle_math::Mat3;
 
@@ -40,10 +41,16 @@ struct Motion<F> {
 
 /// One 8-float row of each lane's body: `motion` picks [`BodyState::motion_row`], else
 /// [`BodyState::velocity_row`].
+///
+/// Every kernel reads and writes the body states through [`Shared`] elements: the batches of
+/// one colour write disjoint bodies ([`super::batch`]), so the threads of a colour
+/// ([`super::team`]) never touch one body at once, except the static entry, which is only
+/// read. That is the contract of each access below.
 #[inline(always)]
-fn lane_rows(states: &[BodyState], idx: [u32; LANES], motion: bool) -> [&[f32; 8]; LANES] {
+fn lane_rows(states: &[Shared<BodyState>], idx: [u32; LANES], motion: bool) -> [&[f32; 8]; LANES] {
     rows_of(idx, |i: u32| {
-        let s = &states[i as usize];
+        // SAFETY: the colouring (above): no other thread writes this body meanwhile.
+        let s = unsafe { states[i as usize].get() };
         if motion {
             s.motion_row()
         } else {
@@ -92,7 +99,12 @@ impl<F: Lane> Velocities<F> {
     /// layout, leaving lanes 3 and 7 of each row alone (a body's 1/m and flags in
     /// [`BodyState`]); the static entry is never written.
     #[inline(always)]
-    fn store<B>(&self, idx: [u32; LANES], bodies: &mut [B], row: impl Fn(&mut B) -> &mut [f32; 8]) {
+    fn store<B>(
+        &self,
+        idx: [u32; LANES],
+        bodies: &[Shared<B>],
+        row: impl Fn(&mut B) -> &mut [f32; 8],
+    ) {
         let rows = F::transpose([
             self.linear.x,
             self.linear.y,
@@ -105,19 +117,22 @@ impl<F: Lane> Velocities<F> {
         ]);
         for (lane, &i) in idx.iter().enumerate() {
             if i != STATIC_BODY {
-                rows[lane].store_skipping_3_and_7(row(&mut bodies[i as usize]));
+                // SAFETY: the colouring (`lane_rows`): this batch is the only one of its
+                // colour that touches body i, and the rows it read were copied into lanes.
+                let body = unsafe { bodies[i as usize].get_mut() };
+                rows[lane].store_skipping_3_and_7(row(body));
             }
         }
     }
 }
 
 #[inline(always)]
-fn gather_velocities<F: Lane>(states: &[BodyState], idx: [u32; LANES]) -> Velocities<F> {
+fn gather_velocities<F: Lane>(states: &[Shared<BodyState>], idx: [u32; LANES]) -> Velocities<F> {
     Velocities::from_columns(F::load_transposed(lane_rows(states, idx, false)))
 }
 
 #[inline(always)]
-fn gather_motion<F: Lane>(states: &[BodyState], idx: [u32; LANES]) -> Motion<F> {
+fn gather_motion<F: Lane>(states: &[Shared<BodyState>], idx: [u32; LANES]) -> Motion<F> {
     let [qx, qy, qz, qw, px, py, pz, _] = F::load_transposed(lane_rows(states, idx, true));
     Motion {
         position: V3x8 {
@@ -137,31 +152,38 @@ fn gather_motion<F: Lane>(states: &[BodyState], idx: [u32; LANES]) -> Motion<F> 
 }
 
 #[inline(always)]
-fn scatter_velocities<F: Lane>(states: &mut [BodyState], idx: [u32; LANES], v: &Velocities<F>) {
+fn scatter_velocities<F: Lane>(states: &[Shared<BodyState>], idx: [u32; LANES], v: &Velocities<F>) {
     v.store(idx, states, BodyState::velocity_row_mut);
 }
 
 /// Whether any of the eight bodies moves with pseudo velocities in this substep (its
 /// [`PseudoRow`] is marked in lane 3 by [`scatter_pseudo`]).
 #[inline(always)]
-fn any_pseudo(pseudo: &[PseudoRow], idx: [u32; LANES]) -> bool {
-    idx.iter().any(|&i| pseudo[i as usize][3] != 0.0)
+fn any_pseudo(pseudo: &[Shared<PseudoRow>], idx: [u32; LANES]) -> bool {
+    // SAFETY: the colouring (`lane_rows`).
+    idx.iter()
+        .any(|&i| unsafe { pseudo[i as usize].get() }[3] != 0.0)
 }
 
 /// The pseudo velocities of eight bodies, by lane: rows of [`PseudoRow`] (see
 /// [`solve`]).
 #[inline(always)]
-fn gather_pseudo<F: Lane>(pseudo: &[PseudoRow], idx: [u32; LANES]) -> Velocities<F> {
-    Velocities::from_columns(F::load_transposed(rows_of(idx, |i| &pseudo[i as usize])))
+fn gather_pseudo<F: Lane>(pseudo: &[Shared<PseudoRow>], idx: [u32; LANES]) -> Velocities<F> {
+    // SAFETY: the colouring (`lane_rows`).
+    Velocities::from_columns(F::load_transposed(rows_of(idx, |i| unsafe {
+        pseudo[i as usize].get()
+    })))
 }
 
 /// Stores the pseudo velocities of eight bodies and marks their rows (lane 3) as moving.
 #[inline(always)]
-fn scatter_pseudo<F: Lane>(pseudo: &mut [PseudoRow], idx: [u32; LANES], v: &Velocities<F>) {
+fn scatter_pseudo<F: Lane>(pseudo: &[Shared<PseudoRow>], idx: [u32; LANES], v: &Velocities<F>) {
     v.store(idx, pseudo, |row| row);
     for &i in &idx {
         if i != STATIC_BODY {
-            pseudo[i as usize][3] = 1.0;
+            // SAFETY: the colouring (`lane_rows`).
+            let row = unsafe { pseudo[i as usize].get_mut() };
+            row[3] = 1.0;
         }
     }
 }
@@ -176,7 +198,7 @@ struct Pair<F> {
 
 impl<F: Lane> Pair<F> {
     #[inline(always)]
-    fn load(m: &ManifoldLanes<F>, states: &[BodyState]) -> Self {
+    fn load(m: &ManifoldLanes<F>, states: &[Shared<BodyState>]) -> Self {
         Self {
             a: gather_velocities(states, m.a),
             b: gather_velocities(states, m.b),
@@ -186,7 +208,7 @@ impl<F: Lane> Pair<F> {
     }
 
     #[inline(always)]
-    fn store(&self, m: &ManifoldLanes<F>, states: &mut [BodyState]) {
+    fn store(&self, m: &ManifoldLanes<F>, states: &[Shared<BodyState>]) {
         scatter_velocities(states, m.a, &self.a);
         scatter_velocities(states, m.b, &self.b);
     }
@@ -234,33 +256,50 @@ fn separation<F: Lane>(p: &PointLanes<F>, a: &Motion<F>, b: &Motion<F>) -> F {
 /// Measured on the 20-row pyramid (`jostle run assets/pyramid_20.ron --no-sleep`, AMD EPYC with
 /// AVX-512, resolve stage median): 0.245 ms per step with 128-bit halves, 0.200 ms with 256-bit
 /// lanes (RESULTS.md, "What changed on 2026-11-22, afternoon").
+///
+/// The function runs over the batches `manifolds` (one colour's, or all), whose points are
+/// `points`, the first of them at index `base` of [`Batches::points`], with the body states
+/// shared ([`Shared`]): the threads of [`super::team`] each run it on their own batches of a
+/// colour at once.
 macro_rules! wide_kernel {
-    ($(#[$doc:meta])* pub fn $name:ident(batches: &mut Batches $(, $arg:ident: $ty:ty)*) -> $ret:ty = $imp:ident;) => {
+    ($(#[$doc:meta])* pub(crate) fn $name:ident($($arg:ident: $ty:ty),*) = $imp:ident;) => {
         $(#[$doc])*
-        pub fn $name(batches: &mut Batches $(, $arg: $ty)*) -> $ret {
-            let Batches {
-                manifolds, points, ..
-            } = batches;
-            with_best_lanes!($imp(manifolds, points $(, $arg: $ty)*) -> $ret)
+        pub(crate) fn $name(
+            manifolds: &mut [ManifoldLanes],
+            points: &mut [PointLanes],
+            base: u32,
+            states: &[Shared<BodyState>]
+            $(, $arg: $ty)*
+        ) {
+            with_best_lanes!($imp(
+                manifolds,
+                points,
+                base: u32,
+                states: &[Shared<BodyState>]
+                $(, $arg: $ty)*
+            ) -> ())
         }
     };
 }
 
 /// Runs `$body` for every batch in order, with `$m` the batch, `$pair` its loaded bodies
-/// (stored back after the body), `$points` its points and `$st` the body states (read only
-/// inside). A macro rather than a closure so the body is compiled inline, with the caller's
-/// target features.
+/// (stored back after the body), `$points` its points and `$st` the body states. `$points`
+/// holds the points of `$manifolds` only, the first at index `$base` of the whole
+/// [`Batches::points`]. A macro rather than a closure so the body is compiled inline, with the
+/// caller's target features.
 macro_rules! for_each_batch {
-    ($manifolds:expr, $points:expr, $states:expr, |$m:ident, $pair:ident, $pts:ident, $st:ident| $body:block) => {{
-        let states: &mut [BodyState] = $states;
+    ($manifolds:expr, $points:expr, $base:expr, $states:expr, |$m:ident, $pair:ident, $pts:ident, $st:ident| $body:block) => {{
+        let states: &[Shared<BodyState>] = $states;
         let all_points = $points;
+        let base: u32 = $base;
         for $m in $manifolds.iter() {
             let mut pair = Pair::load($m, states);
-            let range = $m.first as usize..($m.first + $m.count) as usize;
+            let first = ($m.first - base) as usize;
+            let range = first..first + $m.count as usize;
             {
                 let $pair = &mut pair;
                 let $pts = &mut all_points[range];
-                let $st: &[BodyState] = states;
+                let $st: &[Shared<BodyState>] = states;
                 $body
             }
             pair.store($m, states);
@@ -272,22 +311,37 @@ macro_rules! for_each_batch {
 fn warm_start_impl<F: Lane>(
     manifolds: &[ManifoldLanes<F>],
     points: &mut [PointLanes<F>],
-    states: &mut [BodyState],
+    base: u32,
+    states: &[Shared<BodyState>],
 ) {
-    for_each_batch!(manifolds, points, states, |m, pair, points, _states| {
-        for p in points.iter() {
-            pair.apply_normal(p, p.normal_impulse);
-            if m.friction {
-                pair.apply_tangent(p, p.tangent_impulse[0], p.tangent_impulse[1]);
+    for_each_batch!(
+        manifolds,
+        points,
+        base,
+        states,
+        |m, pair, points, _states| {
+            for p in points.iter() {
+                pair.apply_normal(p, p.normal_impulse);
+                if m.friction {
+                    pair.apply_tangent(p, p.tangent_impulse[0], p.tangent_impulse[1]);
+                }
             }
         }
-    });
+    );
+}
+
+/// Applies every contact's accumulated impulse (the previous substep's, or on the first
+/// substep the previous step's): the solver then only corrects what changed.
+pub fn warm_start(batches: &mut Batches, states: &mut [BodyState]) {
+    let Batches {
+        manifolds, points, ..
+    } = batches;
+    warm_start_range(manifolds, points, 0, share(states));
 }
 
 wide_kernel! {
-    /// Applies every contact's accumulated impulse (the previous substep's, or on the first
-    /// substep the previous step's): the solver then only corrects what changed.
-    pub fn warm_start(batches: &mut Batches, states: &mut [BodyState]) -> () = warm_start_impl;
+    /// [`warm_start`] over some batches.
+    pub(crate) fn warm_start_range() = warm_start_impl;
 }
 
 /// Newton iterations of the friction disk projection (see [`solve_friction`]); the secular
@@ -453,14 +507,15 @@ pub struct RowState {
 /// [`super::direct`] solves these rows of a whole island at once. The same arithmetic as
 /// the pass's own kernels.
 pub fn row_residuals(
-    batches: &Batches,
-    states: &[BodyState],
+    manifolds: &[ManifoldLanes],
+    points: &[PointLanes],
+    states: &[Shared<BodyState>],
     batch: usize,
     point: usize,
     pass: RowPass,
 ) -> [RowState; LANES] {
-    let m = &batches.manifolds[batch];
-    let p = &batches.points[point];
+    let m = &manifolds[batch];
+    let p = &points[point];
     let pair = Pair::<F8>::load(m, states);
     let motion = (&gather_motion(states, m.a), &gather_motion(states, m.b));
     let soft_mass = p.normal_mass * p.mass_scale;
@@ -529,7 +584,7 @@ fn relax_batch<F: Lane>(
     m: &ManifoldLanes<F>,
     pair: &mut Pair<F>,
     points: &mut [PointLanes<F>],
-    states: &[BodyState],
+    states: &[Shared<BodyState>],
     inv_h: f32,
     sweeps: u32,
 ) {
@@ -601,7 +656,7 @@ fn solve_batch_rigid<F: Lane>(
     pseudo: &mut (Velocities<F>, Velocities<F>),
     live: &mut bool,
     points: &mut [PointLanes<F>],
-    states: &[BodyState],
+    states: &[Shared<BodyState>],
     pass: BiasedPass,
 ) {
     let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
@@ -751,7 +806,7 @@ fn solve_batch_split<F: Lane>(
     pseudo: &mut (Velocities<F>, Velocities<F>),
     live: &mut bool,
     points: &mut [PointLanes<F>],
-    states: &[BodyState],
+    states: &[Shared<BodyState>],
     pass: BiasedPass,
 ) {
     let friction = pass.friction;
@@ -782,62 +837,97 @@ fn solve_batch_split<F: Lane>(
 fn solve_impl<F: Lane>(
     manifolds: &[ManifoldLanes<F>],
     points: &mut [PointLanes<F>],
-    states: &mut [BodyState],
-    pseudo: &mut [PseudoRow],
+    base: u32,
+    states: &[Shared<BodyState>],
+    pseudo: &[Shared<PseudoRow>],
     pass: BiasedPass,
 ) {
     // A batch loads and stores pseudo velocities only when one of its bodies already moves
     // with them or one of its points pushes: a settled scene's bodies never do (loading and
     // storing them for every batch costs the 20-row pyramid's resolve stage 13%).
-    for_each_batch!(manifolds, points, states, |m, pair, points, states| {
-        let mut live = any_pseudo(pseudo, m.a) || any_pseudo(pseudo, m.b);
-        let mut split = if live {
-            (gather_pseudo(pseudo, m.a), gather_pseudo(pseudo, m.b))
-        } else {
-            let zero = Velocities::from_columns([F::ZERO; 8]);
-            (zero, zero)
-        };
-        if pass.rigid {
-            solve_batch_rigid(m, pair, &mut split, &mut live, points, states, pass);
-        } else {
-            solve_batch_split(m, pair, &mut split, &mut live, points, states, pass);
+    for_each_batch!(
+        manifolds,
+        points,
+        base,
+        states,
+        |m, pair, points, states| {
+            let mut live = any_pseudo(pseudo, m.a) || any_pseudo(pseudo, m.b);
+            let mut split = if live {
+                (gather_pseudo(pseudo, m.a), gather_pseudo(pseudo, m.b))
+            } else {
+                let zero = Velocities::from_columns([F::ZERO; 8]);
+                (zero, zero)
+            };
+            if pass.rigid {
+                solve_batch_rigid(m, pair, &mut split, &mut live, points, states, pass);
+            } else {
+                solve_batch_split(m, pair, &mut split, &mut live, points, states, pass);
+            }
+            if live {
+                scatter_pseudo(pseudo, m.a, &split.0);
+                scatter_pseudo(pseudo, m.b, &split.1);
+            }
         }
-        if live {
-            scatter_pseudo(pseudo, m.a, &split.0);
-            scatter_pseudo(pseudo, m.b, &split.1);
-        }
-    });
+    );
+}
+
+/// One biased pass with split impulses (`solve_batch_split`): every contact with its own
+/// softness, the push-out of overlap beyond the load's (and beyond the allowance of resting
+/// contacts; at most `max_push_out`, m/s) in the pseudo velocities `pseudo` (one
+/// [`PseudoRow`] per body, zero at the start of the pass), with friction when
+/// [`BiasedPass::friction`] is set; with [`BiasedPass::rigid`], rigid rows and the push-out
+/// of all overlap beyond the slop (`solve_batch_rigid`).
+pub fn solve(
+    batches: &mut Batches,
+    states: &mut [BodyState],
+    pseudo: &mut [PseudoRow],
+    pass: BiasedPass,
+) {
+    let Batches {
+        manifolds, points, ..
+    } = batches;
+    solve_range(manifolds, points, 0, share(states), share(pseudo), pass);
 }
 
 wide_kernel! {
-    /// One biased pass with split impulses (`solve_batch_split`): every contact with its
-    /// own softness, the push-out of overlap beyond the load's (and beyond the allowance of
-    /// resting contacts; at most `max_push_out`, m/s) in the pseudo velocities `pseudo` (one
-    /// [`PseudoRow`] per body, zero at the start of the pass), with friction when
-    /// [`BiasedPass::friction`] is set; with [`BiasedPass::rigid`], rigid rows and the
-    /// push-out of all overlap beyond the slop (`solve_batch_rigid`).
-    pub fn solve(batches: &mut Batches, states: &mut [BodyState], pseudo: &mut [PseudoRow], pass: BiasedPass) -> () = solve_impl;
+    /// [`solve`] over some batches.
+    pub(crate) fn solve_range(pseudo: &[Shared<PseudoRow>], pass: BiasedPass) = solve_impl;
 }
 
 #[inline(always)]
 fn relax_impl<F: Lane>(
     manifolds: &[ManifoldLanes<F>],
     points: &mut [PointLanes<F>],
-    states: &mut [BodyState],
+    base: u32,
+    states: &[Shared<BodyState>],
     inv_h: f32,
     sweeps: u32,
 ) {
-    for_each_batch!(manifolds, points, states, |m, pair, points, states| {
-        relax_batch(m, pair, points, states, inv_h, sweeps);
-    });
+    for_each_batch!(
+        manifolds,
+        points,
+        base,
+        states,
+        |m, pair, points, states| {
+            relax_batch(m, pair, points, states, inv_h, sweeps);
+        }
+    );
+}
+
+/// One relax pass: rigid, without bias, so the velocity the soft constraints' bleed let
+/// through is removed again once the positions moved (speculative contacts keep their gap
+/// rule); `sweeps` > 1 sweeps each manifold's normal rows that often before its friction
+/// (rigid contacts).
+pub fn relax(batches: &mut Batches, states: &mut [BodyState], inv_h: f32, sweeps: u32) {
+    let Batches {
+        manifolds, points, ..
+    } = batches;
+    relax_range(manifolds, points, 0, share(states), inv_h, sweeps);
 }
 
 wide_kernel! {
-    /// One relax pass: rigid, without bias, so the velocity the soft constraints' bleed let
-    /// through is removed again once the positions moved (speculative contacts keep their gap
-    /// rule); `sweeps` > 1 sweeps each manifold's normal rows that often before its friction
-    /// (rigid contacts).
-    pub fn relax(batches: &mut Batches, states: &mut [BodyState], inv_h: f32, sweeps: u32) -> () = relax_impl;
+    /// [`relax`] over some batches.
+    pub(crate) fn relax_range(inv_h: f32, sweeps: u32) = relax_impl;
 }
 
 /// Lanes of `p` that bounce in the restitution pass: e > 0, approached faster than
@@ -920,48 +1010,55 @@ pub fn restitution(
     let Batches {
         manifolds, points, ..
     } = batches;
-    for_each_batch!(manifolds, points, states, |m, pair, points, states| {
-        let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
-        let first = m.first as usize;
-        for (p, now) in points
-            .iter_mut()
-            .zip(&response[first..first + m.count as usize])
-        {
-            let vn = pair.relative_velocity(p).dot(p.normal);
-            let s = separation(p, &motion_a, &motion_b);
-            // A contact that pushed during the step is treated as touching even if a gap
-            // opened: it is part of the impact and must not be allowed to close that gap
-            // (which would turn the rest of an elastic impact into an inelastic one next
-            // step). Only contacts that never engaged keep the speculative allowance.
-            let free_gap = s.cmpgt(F8::ZERO) & p.max_normal_impulse.cmple(F8::ZERO);
-            let separated = p.relative_velocity.cmpgt(F8::ZERO);
-            let resting = F8::select(free_gap, -s * inv_h, F8::ZERO);
-            let target = F8::select(
-                bounces(p, threshold),
-                -p.restitution * p.relative_velocity,
-                resting,
-            );
-            let delta = -now.mass * (vn - target);
-            let total = (p.normal_impulse + delta).max(F8::ZERO);
-            // A point that was separating at the start of the step is no part of the impact,
-            // even if the body turned onto it within the step and it pushed: its elastic
-            // answer is the reversed motion, which drives it back into the surface, where the
-            // next step bounces it. Held at zero closing speed here instead, it forced the
-            // impact's other points above their bounce: a flat box landing on one edge while
-            // its other edge rose gained 60% of its energy in one step (benches/RESULTS.md,
-            // "Restitution 1 never raises a bounce").
-            let total = F8::select(separated, p.normal_impulse, total);
-            let delta = total - p.normal_impulse;
-            p.normal_impulse = total;
-            let correction = F8::select(now.mass.cmpgt(F8::ZERO), delta.abs() / now.mass, F8::ZERO);
-            largest = largest.max(correction);
-            let impulse = p.normal * delta;
-            pair.a.linear += impulse * pair.inv_mass_a;
-            pair.a.angular += now.ang_a * delta;
-            pair.b.linear -= impulse * pair.inv_mass_b;
-            pair.b.angular -= now.ang_b * delta;
+    for_each_batch!(
+        manifolds,
+        points,
+        0,
+        share(states),
+        |m, pair, points, states| {
+            let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
+            let first = m.first as usize;
+            for (p, now) in points
+                .iter_mut()
+                .zip(&response[first..first + m.count as usize])
+            {
+                let vn = pair.relative_velocity(p).dot(p.normal);
+                let s = separation(p, &motion_a, &motion_b);
+                // A contact that pushed during the step is treated as touching even if a gap
+                // opened: it is part of the impact and must not be allowed to close that gap
+                // (which would turn the rest of an elastic impact into an inelastic one next
+                // step). Only contacts that never engaged keep the speculative allowance.
+                let free_gap = s.cmpgt(F8::ZERO) & p.max_normal_impulse.cmple(F8::ZERO);
+                let separated = p.relative_velocity.cmpgt(F8::ZERO);
+                let resting = F8::select(free_gap, -s * inv_h, F8::ZERO);
+                let target = F8::select(
+                    bounces(p, threshold),
+                    -p.restitution * p.relative_velocity,
+                    resting,
+                );
+                let delta = -now.mass * (vn - target);
+                let total = (p.normal_impulse + delta).max(F8::ZERO);
+                // A point that was separating at the start of the step is no part of the impact,
+                // even if the body turned onto it within the step and it pushed: its elastic
+                // answer is the reversed motion, which drives it back into the surface, where the
+                // next step bounces it. Held at zero closing speed here instead, it forced the
+                // impact's other points above their bounce: a flat box landing on one edge while
+                // its other edge rose gained 60% of its energy in one step (benches/RESULTS.md,
+                // "Restitution 1 never raises a bounce").
+                let total = F8::select(separated, p.normal_impulse, total);
+                let delta = total - p.normal_impulse;
+                p.normal_impulse = total;
+                let correction =
+                    F8::select(now.mass.cmpgt(F8::ZERO), delta.abs() / now.mass, F8::ZERO);
+                largest = largest.max(correction);
+                let impulse = p.normal * delta;
+                pair.a.linear += impulse * pair.inv_mass_a;
+                pair.a.angular += now.ang_a * delta;
+                pair.b.linear -= impulse * pair.inv_mass_b;
+                pair.b.angular -= now.ang_b * delta;
+            }
         }
-    });
+    );
     largest.max_element()
 }
 
@@ -1043,9 +1140,10 @@ pub struct ManifoldEnd {
 /// its separation at the end of the step (m) and its manifold's [`ManifoldEnd`].
 pub fn results(
     batches: &Batches,
-    states: &[BodyState],
+    states: &mut [BodyState],
     mut f: impl FnMut(u32, jostle_math::Vec3, f32, ManifoldEnd),
 ) {
+    let states = share(states);
     let mut separations = [F8::ZERO; MAX_POINTS];
     for m in &batches.manifolds {
         let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
@@ -1185,16 +1283,24 @@ mod tests {
         let Batches {
             manifolds, points, ..
         } = &mut narrow_batches;
-        let mut narrow_pseudo = vec![[0.0; 8]; narrow_states.len()];
-        warm_start_impl::<F8>(manifolds, points, &mut narrow_states);
+        let mut narrow_pseudo: Vec<PseudoRow> = vec![[0.0; 8]; narrow_states.len()];
+        warm_start_impl::<F8>(manifolds, points, 0, share(&mut narrow_states));
         solve_impl::<F8>(
             manifolds,
             points,
-            &mut narrow_states,
-            &mut narrow_pseudo,
+            0,
+            share(&mut narrow_states),
+            share(&mut narrow_pseudo),
             pass,
         );
-        relax_impl::<F8>(manifolds, points, &mut narrow_states, inv_h, pass.sweeps);
+        relax_impl::<F8>(
+            manifolds,
+            points,
+            0,
+            share(&mut narrow_states),
+            inv_h,
+            pass.sweeps,
+        );
         // The pile starts overlapping, so the split push-out did work too.
         assert!(narrow_pseudo.iter().flatten().any(|&x| x != 0.0));
         let mut narrow = bits(&narrow_states, &narrow_batches);

@@ -1,0 +1,635 @@
+//! Several threads through the substeps of one soft step, with results independent of how
+//! many take part.
+//!
+//! A step's substeps are a fixed sequence of *stages*: integrate the velocities, warm start
+//! colour by colour, the biased pass colour by colour, the direct solve, integrate the
+//! positions, relax colour by colour. A stage is a number of *items* (a few batches of one
+//! colour, or a run of bodies) that write disjoint data, so they may run in any order and on
+//! any thread with the same result, bit for bit; a stage starts only when the one before has
+//! finished. Every thread of the team runs the same sequence ([`Crew::stage`]):
+//! - each stage's items are split into one contiguous part per thread by the bodies they
+//!   write ([`Plan`]), so a body is handled by the same thread from stage to stage and its
+//!   state, and each batch's points, stay in that thread's core's cache;
+//! - items are claimed through an atomic counter per part; a thread runs its own part, then
+//!   the parts of threads that have not reached the stage yet, and then waits only for items
+//!   that a running thread has claimed. A thread that starts late, or never, holds nothing
+//!   up: the others take its part. So the team cannot deadlock, however many helpers join.
+//!
+//! The helpers are threads of the process, started on first use, that poll for [`POLL_MICROS`] after
+//! each step before they park: on the two-core virtual machine of benches/RESULTS.md,
+//! starting a rayon job that wakes a sleeping worker cost the caller 13–45 µs and the
+//! worker joined 20–60 µs later, every step (rayon's workers sleep between steps as short as
+//! the narrow phase); a polling helper joins within a microsecond. One world steps on them
+//! at a time; a world whose step finds them busy runs alone.
+//!
+//! Box2D v3 runs its solver stages the same way (`solver.c`, "stages" and "blocks", with a
+//! worker's own blocks first); this is written from that description.
+//!
+//! [`Solo`] is the same sequence on the calling thread alone, each stage's items in order; a
+//! [`Plan`] records the stages without running them, which is how the team learns the
+//! sequence before it starts.
+
+use std::cell::{Cell, RefCell};
+use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
+
+/// Most threads a team uses.
+pub const MAX_THREADS: usize = 8;
+
+/// Something that runs the stages of the substeps: [`Plan`], [`Solo`] or a [`Member`] of a
+/// [`Team`].
+pub trait Crew {
+    /// Runs `f(i)` for every item `i` in `0..items`, each once, in any order and on any
+    /// thread of the crew, and returns when all have finished (their writes visible to this
+    /// thread). Every thread of a crew makes the same calls in the same order. `owner(i)` is
+    /// the body whose thread should run item `i` ([`Plan`]), non-decreasing in `i`.
+    fn stage(&self, items: u32, owner: impl Fn(u32) -> u32, f: impl FnMut(u32));
+}
+
+/// Where each thread's part of a stage's items starts; entry `threads` is the item count.
+pub type Parts = [u32; MAX_THREADS + 1];
+
+/// Records each stage's parts and runs nothing: thread t's part is the items whose owner
+/// body is at least `bounds[t - 1]` and below `bounds[t]`. A body is thus handled by the
+/// same thread in every stage (except where an item holds bodies of two threads), and its
+/// state stays in that thread's core's cache.
+#[derive(Debug, Default)]
+pub struct Plan<'a> {
+    /// The first body of each thread's range but the first's.
+    pub bounds: &'a [u32],
+    /// The parts of each stage, in order.
+    pub stages: RefCell<Vec<Parts>>,
+}
+
+impl Crew for Plan<'_> {
+    fn stage(&self, items: u32, owner: impl Fn(u32) -> u32, _f: impl FnMut(u32)) {
+        let mut parts = [items; MAX_THREADS + 1];
+        parts[0] = 0;
+        for (t, &bound) in self.bounds.iter().enumerate().take(MAX_THREADS - 1) {
+            // The first item owned by a body at or past the bound (owners never decrease).
+            let (mut lo, mut hi) = (parts[t], items);
+            while lo < hi {
+                let mid = lo + (hi - lo) / 2;
+                if owner(mid) < bound {
+                    lo = mid + 1;
+                } else {
+                    hi = mid;
+                }
+            }
+            parts[t + 1] = lo;
+        }
+        self.stages.borrow_mut().push(parts);
+    }
+}
+
+/// The calling thread alone, every item in order.
+#[derive(Debug, Default)]
+pub struct Solo;
+
+impl Crew for Solo {
+    #[inline]
+    fn stage(&self, items: u32, _owner: impl Fn(u32) -> u32, mut f: impl FnMut(u32)) {
+        for i in 0..items {
+            f(i);
+        }
+    }
+}
+
+/// An atomic counter alone on its cache line, so that threads claiming from their own parts
+/// do not contend.
+#[derive(Debug, Default)]
+#[repr(align(64))]
+struct Counter(AtomicU32);
+
+/// One stage's counters: the next unclaimed item of each thread's part, and how many items
+/// have finished.
+#[derive(Debug, Default)]
+struct Slot {
+    next: [Counter; MAX_THREADS],
+    done: Counter,
+}
+
+/// The shared state of a team: counters per stage of the planned sequence.
+#[derive(Debug, Default)]
+pub struct Team {
+    slots: Vec<Slot>,
+    /// Per thread: the stages it has entered. A thread helps only with the parts of threads
+    /// that have not entered the stage yet: taking items from a thread that is working on
+    /// its part would move that part's batches, and their points, to another core's cache.
+    entered: [Counter; MAX_THREADS],
+    parts: Vec<Parts>,
+    threads: usize,
+    /// Set when a member panicked: the others leave their stages.
+    poisoned: std::sync::atomic::AtomicBool,
+}
+
+impl Team {
+    /// Prepares the team of `threads` (1 to [`MAX_THREADS`]) for the stages of `plan`
+    /// (each stage's parts, in order, as [`Plan`] records them for `threads` − 1 bounds).
+    pub fn reset(&mut self, threads: usize, plan: &[Parts]) {
+        debug_assert!((1..=MAX_THREADS).contains(&threads));
+        self.threads = threads.clamp(1, MAX_THREADS);
+        self.parts.clear();
+        self.parts.extend_from_slice(plan);
+        for parts in &mut self.parts {
+            // Parts past the team's threads are empty.
+            let items = parts[MAX_THREADS];
+            for p in &mut parts[self.threads..] {
+                *p = items;
+            }
+        }
+        if self.slots.len() < plan.len() {
+            self.slots.resize_with(plan.len(), Slot::default);
+        }
+        for (slot, parts) in self.slots.iter_mut().zip(&self.parts) {
+            for (t, next) in slot.next.iter_mut().enumerate().take(self.threads) {
+                *next.0.get_mut() = parts[t];
+            }
+            *slot.done.0.get_mut() = 0;
+        }
+        for entered in &mut self.entered {
+            *entered.0.get_mut() = 0;
+        }
+        *self.poisoned.get_mut() = false;
+    }
+
+    /// Threads the team was reset for.
+    pub fn threads(&self) -> usize {
+        self.threads
+    }
+
+    /// Thread `id`'s view of the team (`id` < [`Team::threads`]).
+    pub fn member(&self, id: usize) -> Member<'_> {
+        debug_assert!(id < self.threads);
+        Member {
+            team: self,
+            id,
+            stage: Cell::new(0),
+        }
+    }
+}
+
+/// A clone is a new team, to be reset before use (a team holds no results).
+impl Clone for Team {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
+/// Spins before a waiting thread starts yielding its core (about a microsecond of spinning:
+/// a stage usually ends sooner, and on a busy machine the thread being waited for may need
+/// the core).
+const SPINS_BEFORE_YIELD: u32 = 256;
+
+/// One thread of a [`Team`].
+#[derive(Debug)]
+pub struct Member<'t> {
+    team: &'t Team,
+    id: usize,
+    stage: Cell<usize>,
+}
+
+impl Member<'_> {
+    /// This thread's index in the team (0 for the thread that called [`run`]).
+    pub fn id(&self) -> usize {
+        self.id
+    }
+
+    /// Claims and runs items of `part` of the stage until none is left; returns how many
+    /// this thread ran.
+    fn run_part(&self, slot: &Slot, parts: &Parts, part: usize, f: &mut impl FnMut(u32)) -> u32 {
+        let end = parts[part + 1];
+        let mut ran = 0;
+        loop {
+            // Relaxed: the claim only has to be unique; the data an item reads was published
+            // by the wait that ended the stage before.
+            let i = slot.next[part].0.fetch_add(1, Ordering::Relaxed);
+            if i >= end {
+                return ran;
+            }
+            f(i);
+            ran += 1;
+        }
+    }
+}
+
+impl Crew for Member<'_> {
+    fn stage(&self, items: u32, _owner: impl Fn(u32) -> u32, mut f: impl FnMut(u32)) {
+        let k = self.stage.get();
+        self.stage.set(k + 1);
+        let team = self.team;
+        if team.poisoned.load(Ordering::Relaxed) {
+            return;
+        }
+        let parts = &team.parts[k];
+        debug_assert_eq!(parts[MAX_THREADS], items, "stage {k} differs from the plan");
+        let slot = &team.slots[k];
+        team.entered[self.id]
+            .0
+            .store(k as u32 + 1, Ordering::SeqCst);
+        let mut ran = 0;
+        ran += self.run_part(slot, parts, self.id, &mut f);
+        for j in 1..team.threads {
+            let other = (self.id + j) % team.threads;
+            // Sequentially consistent with the owner's entry above: either the owner sees
+            // its counter advanced by this claim, or this thread sees it has entered, and
+            // then the owner runs every item it has not claimed.
+            if team.entered[other].0.load(Ordering::SeqCst) <= k as u32 {
+                ran += self.run_part(slot, parts, other, &mut f);
+            }
+        }
+        if ran > 0 {
+            // Release: publishes this thread's writes to whoever sees the count complete.
+            slot.done.0.fetch_add(ran, Ordering::Release);
+        }
+        let mut spins = 0u32;
+        // Acquire: every item's writes are visible once all are counted.
+        while slot.done.0.load(Ordering::Acquire) < items {
+            if team.poisoned.load(Ordering::Relaxed) {
+                return;
+            }
+            if spins < SPINS_BEFORE_YIELD {
+                spins += 1;
+                std::hint::spin_loop();
+            } else {
+                std::thread::yield_now();
+            }
+        }
+    }
+}
+
+/// Runs `work(member)` on the calling thread (member 0) and up to [`Team::threads`] − 1
+/// helper threads, each with its [`Member`] of `team`, which must have been reset for
+/// the plan of `work`. Helpers that are busy or asleep join late or not at all; the calling
+/// thread then does their items ([`Crew::stage`]). Returns when every member that started
+/// has finished.
+///
+/// # Panics
+/// When `work` panics on any thread, the team is poisoned: every member leaves its stages
+/// at once (the others would wait forever for the items the panicking one claimed), and
+/// this function panics on the calling thread once no helper is inside `work` any more.
+pub fn run<W>(team: &Team, work: W)
+where
+    W: Fn(&Member<'_>) + Sync,
+{
+    if team.threads > 1
+        && let Some(helpers) = Helpers::get()
+        // One job at a time: a team that finds the helpers busy with another world's step
+        // (another thread's) runs alone, which its stages allow.
+        && let Ok(_busy) = helpers.busy.try_lock()
+    {
+        let job = |id: usize| {
+            let result =
+                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| work(&team.member(id))));
+            if let Err(panic) = result {
+                team.poisoned.store(true, Ordering::SeqCst);
+                if id == 0 {
+                    std::panic::resume_unwind(panic);
+                }
+            }
+        };
+        helpers.run(team.threads, &job);
+        assert!(
+            !team.poisoned.load(Ordering::SeqCst),
+            "a soft-step stage panicked on a helper thread"
+        );
+        return;
+    }
+    work(&team.member(0));
+}
+
+/// Threads a step's team uses: [`set_threads`]' number if one was set, else the environment
+/// variable `JOSTLE_THREADS` if it holds a positive number, else the CPU's available
+/// parallelism; 1 without the `parallel` feature; at most [`MAX_THREADS`].
+pub fn available_threads() -> usize {
+    if cfg!(not(feature = "parallel")) {
+        return 1;
+    }
+    static DEFAULT: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    match THREADS.load(Ordering::Relaxed) {
+        0 => *DEFAULT.get_or_init(|| {
+            std::env::var("JOSTLE_THREADS")
+                .ok()
+                .and_then(|v| v.trim().parse::<usize>().ok())
+                .filter(|&n| n > 0)
+                .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        }),
+        n => n,
+    }
+    .clamp(1, MAX_THREADS)
+}
+
+/// The number of threads every following step's team uses, for the whole process (0: the
+/// CPU's available parallelism, the default). Results do not depend on it, bit for bit; it
+/// only changes speed. With the `parallel` feature off, always 1.
+pub fn set_threads(threads: usize) {
+    THREADS.store(threads, Ordering::Relaxed);
+}
+
+static THREADS: AtomicUsize = AtomicUsize::new(0);
+
+/// How long a helper keeps polling for the next step's work before it parks (µs). A step's
+/// other stages (broad and narrow phase, islands) take a fraction of a millisecond in the
+/// scenes this pays for, so a helper polling that long is still there when the next
+/// substeps start; waking a parked thread costs the caller 13–45 µs on a two-core virtual
+/// machine (benches/RESULTS.md, "Two threads through the substeps").
+pub const POLL_MICROS: u64 = 500;
+
+/// The process's helper threads: [`MAX_THREADS`] − 1 at most, started on first use and kept
+/// for the whole process. Between jobs a helper polls for [`POLL_MICROS`], then parks until
+/// the next job wakes it.
+pub(crate) struct Helpers {
+    board: std::sync::Arc<Board>,
+    /// The helpers started so far (helper i is member i + 1 of a team).
+    threads: [std::sync::OnceLock<std::thread::Thread>; MAX_THREADS - 1],
+    /// Helpers started (or that failed to start: the count stops there).
+    started: std::sync::Mutex<usize>,
+    /// Held while a job runs.
+    busy: std::sync::Mutex<()>,
+}
+
+/// What the caller and the helpers share.
+#[derive(Default)]
+struct Board {
+    /// Odd while a job is open; each job adds 2.
+    epoch: std::sync::atomic::AtomicU64,
+    /// The open job, valid while `epoch` is odd and the helper counted in `active`.
+    job: std::sync::Mutex<Option<JobRef>>,
+    /// The next member id to hand out.
+    seats: AtomicUsize,
+    /// Members in the job's thread count.
+    wanted: AtomicUsize,
+    /// Helpers inside the current job.
+    active: AtomicUsize,
+    /// Per helper: whether it is parked (or about to park).
+    parked: Vec<std::sync::atomic::AtomicBool>,
+}
+
+/// The job's function with its lifetime erased: [`Helpers::run`] keeps it alive until no
+/// helper uses it.
+#[derive(Clone, Copy)]
+struct JobRef(*const (dyn Fn(usize) + Sync));
+
+// SAFETY: the pointee is `Sync`, and `Helpers::run` keeps it alive while helpers use it.
+unsafe impl Send for JobRef {}
+
+impl Helpers {
+    /// The process's helpers, started on first use; `None` without the `parallel` feature or
+    /// when no thread could be started.
+    fn get() -> Option<&'static Helpers> {
+        if cfg!(not(feature = "parallel")) {
+            return None;
+        }
+        static HELPERS: std::sync::OnceLock<Option<Helpers>> = std::sync::OnceLock::new();
+        HELPERS.get_or_init(Helpers::start).as_ref()
+    }
+
+    fn start() -> Option<Helpers> {
+        let board = std::sync::Arc::new(Board {
+            parked: (0..MAX_THREADS - 1)
+                .map(|_| std::sync::atomic::AtomicBool::new(false))
+                .collect(),
+            ..Board::default()
+        });
+        Some(Helpers {
+            board,
+            threads: Default::default(),
+            started: std::sync::Mutex::new(0),
+            busy: std::sync::Mutex::new(()),
+        })
+    }
+
+    /// Starts helpers until `count` have been (at most [`MAX_THREADS`] − 1). A helper that
+    /// cannot be started is not: the team runs with fewer.
+    fn ensure(&self, count: usize) {
+        let count = count.min(MAX_THREADS - 1);
+        if self
+            .threads
+            .get(count.wrapping_sub(1))
+            .is_none_or(|t| t.get().is_some())
+        {
+            return;
+        }
+        let Ok(mut started) = self.started.lock() else {
+            return;
+        };
+        while *started < count {
+            let index = *started;
+            let board = self.board.clone();
+            let spawned = std::thread::Builder::new()
+                .name(format!("jostle-helper-{index}"))
+                .spawn(move || helper(&board, index));
+            let Ok(handle) = spawned else {
+                // Never retried: the count stays short of `count`.
+                *started = MAX_THREADS;
+                return;
+            };
+            let _ = self.threads[index].set(handle.thread().clone());
+            *started += 1;
+        }
+    }
+
+    /// Opens `job` for `threads` − 1 helpers, runs `job(0)`, closes it and waits for the
+    /// helpers that joined.
+    fn run(&self, threads: usize, job: &(dyn Fn(usize) + Sync)) {
+        self.ensure(threads - 1);
+        let board = &*self.board;
+        // SAFETY (lifetime): the job is closed below, and this function returns only when no
+        // helper is inside it (`active` is 0 after the close), even when `job(0)` panics
+        // (the guard aborts then).
+        let erased: *const (dyn Fn(usize) + Sync + '_) = job;
+        let erased = JobRef(unsafe {
+            std::mem::transmute::<
+                *const (dyn Fn(usize) + Sync + '_),
+                *const (dyn Fn(usize) + Sync + 'static),
+            >(erased)
+        });
+        if let Ok(mut slot) = board.job.lock() {
+            *slot = Some(erased);
+        }
+        board.seats.store(1, Ordering::SeqCst);
+        board.wanted.store(threads, Ordering::SeqCst);
+        board.epoch.fetch_add(1, Ordering::SeqCst); // odd: open
+        for (thread, parked) in self.threads.iter().zip(&board.parked).take(threads - 1) {
+            if parked.swap(false, Ordering::SeqCst)
+                && let Some(thread) = thread.get()
+            {
+                thread.unpark();
+            }
+        }
+        struct Close<'a>(&'a Board);
+        impl Drop for Close<'_> {
+            fn drop(&mut self) {
+                // Also while unwinding from a panic of `job(0)`: the team is poisoned then,
+                // so the helpers leave their stages.
+                self.0.epoch.fetch_add(1, Ordering::SeqCst); // even: closed
+                while self.0.active.load(Ordering::SeqCst) != 0 {
+                    std::hint::spin_loop();
+                }
+            }
+        }
+        let close = Close(board);
+        job(0);
+        drop(close);
+    }
+}
+
+/// A helper's life: poll for an open job, join it if a seat is left, run its member; park
+/// when nothing came for [`POLL_MICROS`].
+fn helper(board: &Board, index: usize) {
+    let mut seen = 0u64;
+    let mut poll = true;
+    loop {
+        let epoch = next_job(board, index, seen, poll);
+        poll = index + 1 < board.wanted.load(Ordering::SeqCst);
+        seen = epoch;
+        board.active.fetch_add(1, Ordering::SeqCst);
+        // Joined only if the job is still the open one: the caller closes before it waits for
+        // `active`, so either it sees this helper counted or this helper sees the close.
+        if board.epoch.load(Ordering::SeqCst) == epoch {
+            let id = board.seats.fetch_add(1, Ordering::SeqCst);
+            if id < board.wanted.load(Ordering::SeqCst) {
+                let job = board.job.lock().ok().and_then(|slot| *slot);
+                if let Some(JobRef(job)) = job {
+                    // SAFETY: the job stays alive while this helper is counted in `active`.
+                    let job = unsafe { &*job };
+                    // `run`'s job catches the panics of the work it runs.
+                    job(id);
+                }
+            }
+        }
+        board.active.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// Waits for a job newer than `seen` to open and returns its epoch: polls for
+/// [`POLL_MICROS`], then parks until [`Helpers::run`] unparks it.
+fn next_job(board: &Board, index: usize, seen: u64, poll: bool) -> u64 {
+    let open = |epoch: u64| !epoch.is_multiple_of(2) && epoch != seen;
+    let mut started = std::time::Instant::now();
+    let mut poll_micros = if poll { u128::from(POLL_MICROS) } else { 0 };
+    let mut spins = 0u32;
+    loop {
+        let epoch = board.epoch.load(Ordering::SeqCst);
+        if open(epoch) {
+            return epoch;
+        }
+        spins = spins.wrapping_add(1);
+        if !spins.is_multiple_of(64) || started.elapsed().as_micros() < poll_micros {
+            std::hint::spin_loop();
+            continue;
+        }
+        // Parking: either the caller opening a job sees the flag and unparks, or this
+        // thread sees the job (both sides store, then load, sequentially consistent).
+        board.parked[index].store(true, Ordering::SeqCst);
+        let epoch = board.epoch.load(Ordering::SeqCst);
+        if open(epoch) {
+            board.parked[index].store(false, Ordering::SeqCst);
+            return epoch;
+        }
+        while board.parked[index].load(Ordering::SeqCst) {
+            std::thread::park();
+        }
+        started = std::time::Instant::now();
+        poll_micros = u128::from(POLL_MICROS);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicBool, AtomicU64};
+
+    /// The stages of the test: item counts, each item owned by body `item` (so the parts
+    /// follow `bounds`).
+    fn plan(counts: &[u32], bounds: &[u32]) -> Vec<Parts> {
+        let plan = Plan {
+            bounds,
+            stages: RefCell::default(),
+        };
+        for &items in counts {
+            plan.stage(items, |i| i, |_| {});
+        }
+        plan.stages.into_inner()
+    }
+
+    /// Every item of every stage runs exactly once, and no item starts before the whole
+    /// previous stage has finished, for any number of threads (helpers may join late or not
+    /// at all).
+    #[test]
+    fn every_item_runs_once_after_the_stage_before() {
+        let counts: Vec<u32> = (0..200).map(|k| (k * 7) % 23).collect();
+        for threads in 1..=4 {
+            let bounds: Vec<u32> = (1..threads as u32)
+                .map(|t| t * 23 / threads as u32)
+                .collect();
+            let mut team = Team::default();
+            team.reset(threads, &plan(&counts, &bounds));
+            let total: Vec<AtomicU64> = (0..counts.len()).map(|_| AtomicU64::new(0)).collect();
+            let early = AtomicBool::new(false);
+            let sum = |n: u32| u64::from(n) * u64::from(n + 1) / 2;
+            run(&team, |m| {
+                for (k, &items) in counts.iter().enumerate() {
+                    m.stage(
+                        items,
+                        |i| i,
+                        |i| {
+                            if k > 0 && total[k - 1].load(Ordering::Relaxed) != sum(counts[k - 1]) {
+                                early.store(true, Ordering::Relaxed);
+                            }
+                            total[k].fetch_add(u64::from(i) + 1, Ordering::Relaxed);
+                        },
+                    );
+                }
+            });
+            assert!(
+                !early.load(Ordering::Relaxed),
+                "{threads} threads: a stage started early"
+            );
+            for (k, &items) in counts.iter().enumerate() {
+                assert_eq!(
+                    total[k].load(Ordering::Relaxed),
+                    sum(items),
+                    "{threads} threads, stage {k}"
+                );
+            }
+        }
+    }
+
+    /// A panic in one member's item reaches the caller as a panic, whichever thread it
+    /// happened on, and the team does not hang.
+    #[test]
+    fn a_panicking_item_poisons_the_team() {
+        let counts = [64u32; 20];
+        for threads in 1..=3 {
+            let bounds: Vec<u32> = (1..threads as u32)
+                .map(|t| t * 64 / threads as u32)
+                .collect();
+            let mut team = Team::default();
+            team.reset(threads, &plan(&counts, &bounds));
+            let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                run(&team, |m| {
+                    for (k, &items) in counts.iter().enumerate() {
+                        m.stage(
+                            items,
+                            |i| i,
+                            |i| {
+                                assert!(!(k == 7 && i == 50), "item 50 of stage 7");
+                            },
+                        );
+                    }
+                });
+            }));
+            assert!(result.is_err(), "{threads} threads");
+        }
+    }
+
+    /// Each thread's part holds the items whose owner lies in its range of bodies.
+    #[test]
+    fn parts_follow_the_owners() {
+        let parts = plan(&[10, 0, 3], &[4, 8]);
+        assert_eq!(&parts[0][..3], &[0, 4, 8]);
+        assert!(parts[0][3..].iter().all(|&p| p == 10));
+        assert!(parts[1].iter().all(|&p| p == 0));
+        assert_eq!(&parts[2][..3], &[0, 3, 3]);
+    }
+}
