@@ -91,10 +91,13 @@ pub struct PointLanes<F = F8> {
     /// How fast the preload grows in with the overlap (dimensionless): the spring is
     /// compressed by min(preload, slope · overlap) more ([`super::prepare::prepare_point`]).
     pub preload_slope: F,
+    /// The separation (m) at the bodies' poses when a pass last computed it: the relax pass
+    /// keeps it for the next substep's biased pass ([`super::solve::BiasedPass`]).
+    pub separation: F,
 }
 
-// 200 bytes per contact point: 11 vectors and 17 scalars, each eight lanes wide.
-const _: () = assert!(size_of::<PointLanes>() <= 200 * LANES);
+// 204 bytes per contact point: 11 vectors and 18 scalars, each eight lanes wide.
+const _: () = assert!(size_of::<PointLanes>() <= 204 * LANES);
 
 /// Eight manifolds (one per lane) with disjoint non-static bodies; their points are
 /// `points[first .. first + count]` of the [`Batches`].

@@ -449,7 +449,13 @@ struct Substeps<'a> {
 impl Substeps<'_> {
     /// The substeps, stage by stage on `crew`.
     fn run(&self, crew: &impl Crew, timing: &Timing) {
-        for _ in 0..self.substeps {
+        for substep in 0..self.substeps {
+            // After the first substep the relax pass has stored every point's separation at
+            // the poses the biased pass starts from.
+            let pass = solve::BiasedPass {
+                stored_separation: substep > 0 && self.relax_iterations > 0 && !self.pass.rigid,
+                ..self.pass
+            };
             timing.time(Timing::INTEGRATE, || {
                 self.each_body_range(crew, |states, first| {
                     if self.gyroscopic {
@@ -470,9 +476,9 @@ impl Substeps<'_> {
                     solve::warm_start_range(m, p, base, self.states);
                 });
                 self.each_batch_range(crew, |m, p, base| {
-                    solve::solve_range(m, p, base, self.states, self.pseudo, self.pass);
+                    solve::solve_range(m, p, base, self.states, self.pseudo, pass);
                 });
-                self.direct_correct(crew, solve::RowPass::Biased(self.pass));
+                self.direct_correct(crew, solve::RowPass::Biased(pass));
             });
             timing.time(Timing::INTEGRATE, || {
                 self.each_body_range(crew, |states, first| {
@@ -633,6 +639,7 @@ impl Resolver for SoftStepResolver {
             rigid,
             sweeps,
             rate: self.settings.push_out_rate * inv_h,
+            stored_separation: false,
         };
         let threads = if self.batches.manifolds.len() >= PARALLEL_MIN_BATCHES {
             team::available_threads()

@@ -213,6 +213,8 @@ pub fn prepare_point<F: Lane>(
         relative_velocity: dv.dot(n),
         preload,
         preload_slope,
+        // Computed by the first pass that needs it.
+        separation: F::ZERO,
     };
 }
 

@@ -455,26 +455,16 @@ fn accumulate_normal<F: Lane>(pair: &mut Pair<F>, p: &mut PointLanes<F>, delta: 
 }
 
 /// One rigid, unbiased normal row (a speculative point keeps its gap rule: it may close at
-/// most its gap within the substep), as the relax pass and rigid contacts solve it.
+/// most its gap within the substep), as the relax pass and rigid contacts solve it; `s` is
+/// the point's separation now ([`separation`]).
 #[inline(always)]
-fn solve_normal_rigid<F: Lane>(
-    pair: &mut Pair<F>,
-    p: &mut PointLanes<F>,
-    motion: (&Motion<F>, &Motion<F>),
-    inv_h: F,
-) {
-    accumulate_normal(pair, p, rigid_row(pair, p, motion, inv_h));
+fn solve_normal_rigid<F: Lane>(pair: &mut Pair<F>, p: &mut PointLanes<F>, s: F, inv_h: F) {
+    accumulate_normal(pair, p, rigid_row(pair, p, s, inv_h));
 }
 
 /// The increment of one rigid, unbiased normal row before the clamp ([`solve_normal_rigid`]).
 #[inline(always)]
-fn rigid_row<F: Lane>(
-    pair: &Pair<F>,
-    p: &PointLanes<F>,
-    motion: (&Motion<F>, &Motion<F>),
-    inv_h: F,
-) -> F {
-    let s = separation(p, motion.0, motion.1);
+fn rigid_row<F: Lane>(pair: &Pair<F>, p: &PointLanes<F>, s: F, inv_h: F) -> F {
     let bias = F::select(s.cmpgt(F::ZERO), s * inv_h, F::ZERO);
     let vn = pair.relative_velocity(p).dot(p.normal);
     -p.normal_mass * (vn + bias)
@@ -517,11 +507,11 @@ pub fn row_residuals(
     let m = &manifolds[batch];
     let p = &points[point];
     let pair = Pair::<F8>::load(m, states);
-    let motion = (&gather_motion(states, m.a), &gather_motion(states, m.b));
+    let s = separation(p, &gather_motion(states, m.a), &gather_motion(states, m.b));
     let soft_mass = p.normal_mass * p.mass_scale;
     let (delta, mass, compliance) = match pass {
         RowPass::Biased(pass) => {
-            let row = biased_row(&pair, p, motion, &BiasedConsts::new(&pass));
+            let row = biased_row(&pair, p, s, &BiasedConsts::new(&pass));
             (row.delta, row.mass, row.compliance)
         }
         RowPass::Relax { inv_h } => {
@@ -535,7 +525,7 @@ pub fn row_residuals(
                 F8::ZERO,
             );
             (
-                rigid_row(&pair, p, motion, F8::splat(inv_h)),
+                rigid_row(&pair, p, s, F8::splat(inv_h)),
                 p.normal_mass,
                 spring,
             )
@@ -590,12 +580,16 @@ fn relax_batch<F: Lane>(
 ) {
     let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
     let inv_h = F::splat(inv_h);
-    let motion = (&motion_a, &motion_b);
+    // The separations at the poses this substep reached: kept for the next substep's biased
+    // pass, which starts from the same poses (`BiasedPass::stored_separation`).
+    for p in points.iter_mut() {
+        p.separation = separation(p, &motion_a, &motion_b);
+    }
     if sweeps > 1 {
         // Rigid contacts: the normal rows first, `sweeps` times, then friction.
         for _ in 0..sweeps {
             for p in points.iter_mut() {
-                solve_normal_rigid(pair, p, motion, inv_h);
+                solve_normal_rigid(pair, p, p.separation, inv_h);
             }
         }
         if m.friction {
@@ -606,7 +600,7 @@ fn relax_batch<F: Lane>(
         return;
     }
     for p in points.iter_mut() {
-        solve_normal_rigid(pair, p, motion, inv_h);
+        solve_normal_rigid(pair, p, p.separation, inv_h);
         if m.friction {
             solve_friction(pair, p);
         }
@@ -639,6 +633,11 @@ pub struct BiasedPass {
     /// Push-out rate of rigid contacts (1/s):
     /// [`super::SoftStepSettings::push_out_rate`] / h.
     pub rate: f32,
+    /// Every point's [`PointLanes::separation`] holds its separation at the bodies' poses
+    /// now: the relax pass of the substep before stored it, at the same poses (the velocity
+    /// integration between moves no body). The split pass then takes it instead of
+    /// computing it again; rigid contacts compute it always.
+    pub stored_separation: bool,
 }
 
 /// The biased pass over one batch with rigid contacts
@@ -665,9 +664,13 @@ fn solve_batch_rigid<F: Lane>(
     let slop = F::splat(pass.slop);
     let rate = F::splat(pass.rate);
     debug_assert!(points.len() <= MAX_POINTS);
+    let mut now = [F::ZERO; MAX_POINTS];
+    for (p, s) in points.iter().zip(now.iter_mut()) {
+        *s = separation(p, &motion_a, &motion_b);
+    }
     for _ in 0..pass.sweeps {
-        for p in points.iter_mut() {
-            solve_normal_rigid(pair, p, (&motion_a, &motion_b), inv_h);
+        for (p, &s) in points.iter_mut().zip(&now) {
+            solve_normal_rigid(pair, p, s, inv_h);
         }
     }
     if pass.friction && m.friction {
@@ -731,14 +734,14 @@ struct BiasedRow<F> {
     compliance: F,
 }
 
+/// `s` is the point's separation now ([`separation`]).
 #[inline(always)]
 fn biased_row<F: Lane>(
     pair: &Pair<F>,
     p: &PointLanes<F>,
-    (motion_a, motion_b): (&Motion<F>, &Motion<F>),
+    s: F,
     c: &BiasedConsts<F>,
 ) -> BiasedRow<F> {
-    let s = separation(p, motion_a, motion_b);
     let speculative = s.cmpgt(F::ZERO);
     let soft_mass = p.normal_mass * p.mass_scale;
     let bleed = p.impulse_scale * p.normal_impulse;
@@ -810,10 +813,15 @@ fn solve_batch_split<F: Lane>(
     pass: BiasedPass,
 ) {
     let friction = pass.friction;
-    let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
+    if !pass.stored_separation {
+        let (motion_a, motion_b) = (gather_motion(states, m.a), gather_motion(states, m.b));
+        for p in points.iter_mut() {
+            p.separation = separation(p, &motion_a, &motion_b);
+        }
+    }
     let consts = BiasedConsts::new(&pass);
     for p in points.iter_mut() {
-        let row = biased_row(pair, p, (&motion_a, &motion_b), &consts);
+        let row = biased_row(pair, p, p.separation, &consts);
         accumulate_normal(pair, p, row.delta);
 
         // Pseudo velocities can only change where some lane has excess overlap or the
@@ -1260,6 +1268,7 @@ mod tests {
             rigid: false,
             sweeps: 1,
             rate: 0.2 * 4.0 / DT,
+            stored_separation: false,
         };
         // Rigid contacts: other kernels, several sweeps, friction in the biased pass.
         const RIGID: BiasedPass = BiasedPass {
