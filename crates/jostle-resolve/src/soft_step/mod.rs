@@ -19,7 +19,9 @@
 //!    relax (solve again without bias). Friction is solved in the relax pass only, unless
 //!    [`SoftStepSettings::friction_in_bias_pass`] is set. After each pass the islands of
 //!    [`direct`] are solved exactly ([`direct::DirectIslands::correct`]), where Gauss-Seidel
-//!    would need about as many sweeps as their mass ratio.
+//!    would need about as many sweeps as their mass ratio. With [`PARALLEL_MIN_BATCHES`]
+//!    batches or more the substeps run on a team of threads, with the same result bit for
+//!    bit ([`team`]).
 //! 3. restitution, skipped when no contact bounces: Newton's law at every point that approached
 //!    faster than the threshold, swept to convergence with the rest of the contacts, through
 //!    each body's inertia as it has turned since the start of the step
