@@ -552,6 +552,17 @@ mod tests {
         plan.stages.into_inner()
     }
 
+    /// A team of `threads` for stages of `counts` items, whose owners 0..`owners` are split
+    /// evenly among the threads.
+    fn team(threads: usize, counts: &[u32], owners: u32) -> Team {
+        let bounds: Vec<u32> = (1..threads as u32)
+            .map(|t| t * owners / threads as u32)
+            .collect();
+        let mut team = Team::default();
+        team.reset(threads, &plan(counts, &bounds));
+        team
+    }
+
     /// Every item of every stage runs exactly once, and no item starts before the whole
     /// previous stage has finished, for any number of threads (helpers may join late or not
     /// at all).
@@ -559,11 +570,7 @@ mod tests {
     fn every_item_runs_once_after_the_stage_before() {
         let counts: Vec<u32> = (0..200).map(|k| (k * 7) % 23).collect();
         for threads in 1..=4 {
-            let bounds: Vec<u32> = (1..threads as u32)
-                .map(|t| t * 23 / threads as u32)
-                .collect();
-            let mut team = Team::default();
-            team.reset(threads, &plan(&counts, &bounds));
+            let team = team(threads, &counts, 23);
             let total: Vec<AtomicU64> = (0..counts.len()).map(|_| AtomicU64::new(0)).collect();
             let early = AtomicBool::new(false);
             let sum = |n: u32| u64::from(n) * u64::from(n + 1) / 2;
@@ -601,11 +608,7 @@ mod tests {
     fn a_panicking_item_poisons_the_team() {
         let counts = [64u32; 20];
         for threads in 1..=3 {
-            let bounds: Vec<u32> = (1..threads as u32)
-                .map(|t| t * 64 / threads as u32)
-                .collect();
-            let mut team = Team::default();
-            team.reset(threads, &plan(&counts, &bounds));
+            let team = team(threads, &counts, 64);
             let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 run(&team, |m| {
                     for (k, &items) in counts.iter().enumerate() {
