@@ -2,21 +2,15 @@
 //! into velocities, velocities into the step's position and rotation deltas.
 //!
 //! Semi-implicit Euler at the substep length h, as Box2D v3's `b2IntegrateVelocitiesTask` and
-//! `b2IntegratePositionsTask`. Index 0 (the static entry) is never touched.
+//! `b2IntegratePositionsTask`. Each function takes a run of body states after index 0 (the
+//! static entry, which is never touched), so that threads can integrate runs of their own.
 
 use super::body_state::{BodyState, PseudoRow};
 use super::gyroscopic::{gyroscopic_step, rotate_inertia};
-use crate::STATIC_BODY;
 use jostle_math::{Mat3, Quat, Vec3, integrate_orientation};
 
-/// v ← v + g·h for every body with mass; no angular change.
+/// v ← v + g·h for every body of `states` with mass; no angular change.
 pub fn integrate_velocities(states: &mut [BodyState], gravity: Vec3, h: f32) {
-    let start = (STATIC_BODY as usize + 1).min(states.len());
-    integrate_velocities_of(&mut states[start..], gravity, h);
-}
-
-/// [`integrate_velocities`] for every body of `states` (none of them the static entry).
-pub fn integrate_velocities_of(states: &mut [BodyState], gravity: Vec3, h: f32) {
     let dv = gravity * h;
     for s in states.iter_mut() {
         if s.inv_mass > 0.0 {
@@ -31,24 +25,11 @@ pub fn integrate_velocities_of(states: &mut [BodyState], gravity: Vec3, h: f32) 
 /// change every substep, and a body that slow turns less than 2.4 mrad per second.
 pub const GYROSCOPIC_CUTOFF: f32 = 1e-5;
 
-/// [`integrate_velocities`] plus the implicit gyroscopic term for every rotating body whose
-/// step-start world inertia `inertia[i]` is known (non-zero) and which turns by at least
-/// [`GYROSCOPIC_CUTOFF`] per substep, the inertia rotated by the body's motion since the
+/// [`integrate_velocities`] plus the implicit gyroscopic term for every rotating body of
+/// `states` whose step-start world inertia `inertia[i]` is known (non-zero) and which turns
+/// by at least [`GYROSCOPIC_CUTOFF`] per substep, the inertia rotated by the body's motion since the
 /// start of the step ([`rotate_inertia`]).
 pub fn integrate_velocities_gyroscopic(
-    states: &mut [BodyState],
-    inertia: &[Mat3],
-    gravity: Vec3,
-    h: f32,
-) {
-    debug_assert_eq!(states.len(), inertia.len());
-    let start = (STATIC_BODY as usize + 1).min(states.len());
-    integrate_velocities_gyroscopic_of(&mut states[start..], &inertia[start..], gravity, h);
-}
-
-/// [`integrate_velocities_gyroscopic`] for every body of `states` (none of them the static
-/// entry), `inertia` theirs.
-pub fn integrate_velocities_gyroscopic_of(
     states: &mut [BodyState],
     inertia: &[Mat3],
     gravity: Vec3,
@@ -70,8 +51,8 @@ pub fn integrate_velocities_gyroscopic_of(
     }
 }
 
-/// Δx ← Δx + (v + v̂)·h and Δq ← Δq rotated by ω·h ([`integrate_orientation`], which acts in
-/// world space, so Δq·q₀ is exactly the orientation integrated directly), then by the pseudo
+/// For every body of `states`, `pseudo` theirs: Δx ← Δx + (v + v̂)·h and Δq ← Δq rotated by
+/// ω·h ([`integrate_orientation`], which acts in world space, so Δq·q₀ is exactly the orientation integrated directly), then by the pseudo
 /// rotation ω̂·h, with v̂, ω̂ the pseudo velocities of `pseudo` ([`PseudoRow`]), which are then
 /// cleared.
 ///
@@ -80,14 +61,6 @@ pub fn integrate_velocities_gyroscopic_of(
 /// Left in world space, ω would meet an inertia tensor turned under it (a box spinning at
 /// 10 rad/s pushed out of the floor gained 2.8% of its energy that way).
 pub fn integrate_positions(states: &mut [BodyState], pseudo: &mut [PseudoRow], h: f32) {
-    debug_assert_eq!(states.len(), pseudo.len());
-    let start = (STATIC_BODY as usize + 1).min(states.len());
-    integrate_positions_of(&mut states[start..], &mut pseudo[start..], h);
-}
-
-/// [`integrate_positions`] for every body of `states` (none of them the static entry),
-/// `pseudo` theirs.
-pub fn integrate_positions_of(states: &mut [BodyState], pseudo: &mut [PseudoRow], h: f32) {
     debug_assert_eq!(states.len(), pseudo.len());
     for (s, p) in states.iter_mut().zip(pseudo.iter_mut()) {
         let linear = Vec3::new(p[0], p[1], p[2]);

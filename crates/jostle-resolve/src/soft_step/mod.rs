@@ -462,14 +462,14 @@ impl Substeps<'_> {
                 self.each_body_range(crew, |states, first| {
                     if self.gyroscopic {
                         let inertia = &self.inertia[first..first + states.len()];
-                        integrate::integrate_velocities_gyroscopic_of(
+                        integrate::integrate_velocities_gyroscopic(
                             states,
                             inertia,
                             self.gravity,
                             self.h,
                         );
                     } else {
-                        integrate::integrate_velocities_of(states, self.gravity, self.h);
+                        integrate::integrate_velocities(states, self.gravity, self.h);
                     }
                 });
             });
@@ -486,7 +486,7 @@ impl Substeps<'_> {
                 self.each_body_range(crew, |states, first| {
                     // SAFETY: the body ranges of a stage are disjoint (as for `states`).
                     let pseudo = unsafe { slice_mut(self.pseudo, first..first + states.len()) };
-                    integrate::integrate_positions_of(states, pseudo, self.h);
+                    integrate::integrate_positions(states, pseudo, self.h);
                 });
             });
             timing.time(Timing::RELAX, || {
@@ -512,8 +512,7 @@ impl Substeps<'_> {
             let (start, end) = (group[0], group[1]);
             let items = (end - start).div_ceil(self.batch_chunk);
             let owner = |i: u32| {
-                // SAFETY: the batches are only read during the substeps' stages... (the
-                // planning pass runs before any thread starts).
+                // SAFETY: only `Plan` calls this, before any thread runs a stage.
                 batch_owner(unsafe {
                     self.manifolds[(start + i * self.batch_chunk) as usize].get()
                 })

@@ -152,12 +152,7 @@ impl Team {
         *self.poisoned.get_mut() = false;
     }
 
-    /// Threads the team was reset for.
-    pub fn threads(&self) -> usize {
-        self.threads
-    }
-
-    /// Thread `id`'s view of the team (`id` < [`Team::threads`]).
+    /// Thread `id`'s view of the team (`id` below the threads it was reset for).
     pub fn member(&self, id: usize) -> Member<'_> {
         debug_assert!(id < self.threads);
         Member {
@@ -257,7 +252,7 @@ impl Crew for Member<'_> {
     }
 }
 
-/// Runs `work(member)` on the calling thread (member 0) and up to [`Team::threads`] − 1
+/// Runs `work(member)` on the calling thread (member 0) and up to the team's threads − 1
 /// helper threads, each with its [`Member`] of `team`, which must have been reset for
 /// the plan of `work`. Helpers that are busy or asleep join late or not at all; the calling
 /// thread then does their items ([`Crew::stage`]). Returns when every member that started
