@@ -9,6 +9,35 @@ use thiserror::Error;
 /// Default density (kg/m³) of a body that gives neither mass nor density: water's.
 pub const DEFAULT_DENSITY: f32 = 1000.0;
 
+/// The fastest a body may start (m/s): 100 km/s, well beyond any projectile, and far enough
+/// below f32's range that its kinetic energy and the impulses that stop it stay finite at
+/// [`MAX_MASS`] (above it, `linear_velocity: (3e38, 0, 0)` made the energy infinite).
+pub const MAX_SPEED: f32 = 1.0e5;
+
+/// The fastest a body may start spinning (rad/s): at 10,000 rad/s one step at 60 Hz already
+/// turns a body 167 rad; faster spins went non-finite in the first step.
+pub const MAX_ANGULAR_SPEED: f32 = 1.0e4;
+
+/// The heaviest body (kg), given as `mass` or reached through `density` × volume: 10²⁴ kg (a
+/// moon), so that its momentum and kinetic energy at [`MAX_SPEED`] (10²⁹ N·s, 5·10³³ J) and
+/// the impulses that stop it stay finite in f32 (at most 3.4·10³⁸).
+pub const MAX_MASS: f32 = 1.0e24;
+
+/// The densest material (kg/m³): 10⁶, forty times osmium's.
+pub const MAX_DENSITY: f32 = 1.0e6;
+
+/// `q` scaled to unit length, for any finite non-zero quaternion however large or small its
+/// components (`Quat::normalize` squares them first: `(0, 0, 0, 1e30)` overflowed to NaN);
+/// `None` when it has no direction.
+pub(crate) fn unit_rotation(q: Quat) -> Option<Quat> {
+    let largest = q.to_array().into_iter().fold(0.0f32, |m, x| m.max(x.abs()));
+    if !(largest.is_finite() && largest > 0.0 && q.is_finite()) {
+        return None;
+    }
+    let unit = (q / largest).normalize();
+    unit.is_finite().then_some(unit)
+}
+
 /// How a dynamic body's mass is given.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum MassSpec {
@@ -159,6 +188,31 @@ impl BodyDesc {
         vec("position", self.position)?;
         vec("linear_velocity", self.linear_velocity)?;
         vec("angular_velocity", self.angular_velocity)?;
+        let at_most = |field: &str, v: Vec3, limit: f32, unit: &str| {
+            let length = v
+                .to_array()
+                .map(|x| f64::from(x).powi(2))
+                .iter()
+                .sum::<f64>()
+                .sqrt();
+            if length <= f64::from(limit) {
+                Ok(())
+            } else {
+                Err(err(
+                    field,
+                    format!(
+                        "its length {length:.3e} {unit} is above the limit of {limit:e} {unit}"
+                    ),
+                ))
+            }
+        };
+        at_most("linear_velocity", self.linear_velocity, MAX_SPEED, "m/s")?;
+        at_most(
+            "angular_velocity",
+            self.angular_velocity,
+            MAX_ANGULAR_SPEED,
+            "rad/s",
+        )?;
         if self.lock_rotation && !self.fixed && self.angular_velocity != Vec3::ZERO {
             return Err(err(
                 "angular_velocity",
@@ -168,7 +222,7 @@ impl BodyDesc {
                 ),
             ));
         }
-        if !self.rotation.is_finite() || self.rotation.length_squared() < 1e-12 {
+        if unit_rotation(self.rotation).is_none() {
             return Err(err(
                 "rotation",
                 format!(
@@ -198,6 +252,18 @@ impl BodyDesc {
                 }
                 MassSpec::Density(d) if !(d.is_finite() && d > 0.0) => {
                     return Err(err("density", format!("must be finite and > 0, got {d}")));
+                }
+                MassSpec::Mass(m) if m > MAX_MASS => {
+                    return Err(err(
+                        "mass",
+                        format!("{m:e} kg is above the limit of {MAX_MASS:e} kg"),
+                    ));
+                }
+                MassSpec::Density(d) if d > MAX_DENSITY => {
+                    return Err(err(
+                        "density",
+                        format!("{d:e} kg/m³ is above the limit of {MAX_DENSITY:e} kg/m³"),
+                    ));
                 }
                 _ => {}
             }

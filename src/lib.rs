@@ -36,7 +36,9 @@ mod stages;
 pub mod view;
 pub mod world;
 
-pub use body_desc::{BodyDesc, BodyError, MassSpec};
+pub use body_desc::{
+    BodyDesc, BodyError, MAX_ANGULAR_SPEED, MAX_DENSITY, MAX_MASS, MAX_SPEED, MassSpec,
+};
 pub use jostle_body::{BodyHandle, CcdMode, RigidBody};
 pub use jostle_collide::{
     BodyContact, CollideSettings, CollisionEvent, DisplayMesh, Material, RayHit, ShapeDesc,

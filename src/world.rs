@@ -4,7 +4,7 @@
 //! "The step pipeline"); each stage is a small function in `stages.rs` over exactly the data it
 //! touches.
 
-use crate::body_desc::{BodyDesc, BodyError, MassSpec, shape_error};
+use crate::body_desc::{BodyDesc, BodyError, MAX_MASS, MassSpec, shape_error, unit_rotation};
 use crate::profile::StepProfile;
 use crate::settings::WorldSettings;
 use crate::stages::{self, Scratch};
@@ -114,7 +114,7 @@ impl World {
     pub fn add_body(&mut self, desc: BodyDesc) -> Result<BodyHandle, BodyError> {
         desc.validate()?;
         let shape = desc.shape.build().map_err(|e| shape_error(&desc.name, e))?;
-        let rotation = desc.rotation.normalize();
+        let rotation = unit_rotation(desc.rotation).unwrap_or(Quat::IDENTITY);
         let (body, local_pose) = if desc.fixed {
             (
                 RigidBody::fixed().with_pose(desc.position, rotation),
@@ -129,6 +129,15 @@ impl World {
                 mass_properties(&desc.shape, density).map_err(|e| shape_error(&desc.name, e))?;
             if let MassSpec::Mass(m) = desc.mass {
                 props = props.scaled_to_mass(m);
+            } else if props.mass > MAX_MASS {
+                return Err(BodyError::Field {
+                    body: desc.name.clone(),
+                    field: "density".into(),
+                    message: format!(
+                        "gives the shape a mass of {:e} kg, above the limit of {MAX_MASS:e} kg",
+                        props.mass
+                    ),
+                });
             }
             let body =
                 RigidBody::dynamic(props.mass, props.inertia).map_err(|e| BodyError::Field {
@@ -280,15 +289,15 @@ impl World {
         rotation: Quat,
     ) -> Result<(), StepError> {
         Self::finite("position", position)?;
-        if !rotation.is_finite() || rotation.length_squared() < 1e-12 {
+        let Some(unit) = unit_rotation(rotation) else {
             return Err(StepError::NonFinite {
                 what: "rotation",
                 value: format!("{rotation:?}"),
             });
-        }
+        };
         let body = self.body_mut_awake(handle)?;
         body.position = position;
-        body.orientation = rotation.normalize();
+        body.orientation = unit;
         body.update_world_inertia();
         Ok(())
     }

@@ -278,3 +278,71 @@ fn generators_that_would_exhaust_memory_are_errors() {
     assert!(Scene::parse("Scene(generators: [Pyramid(rows: 100000)])", "p.ron").is_err());
     assert!(Scene::parse("Scene(generators: [Pyramid(rows: 1000)])", "p.ron").is_ok());
 }
+
+#[test]
+fn values_beyond_what_f32_physics_holds_name_the_field_and_the_limit() {
+    let message = |text: &str| match error(text) {
+        SceneError::Body {
+            error: jostle::BodyError::Field { field, message, .. },
+            ..
+        } => (field, message),
+        other => panic!("expected a body error, got {other}"),
+    };
+    let cases = [
+        (
+            "linear_velocity: (3e38, 0.0, 0.0)",
+            "linear_velocity",
+            "1e5 m/s",
+        ),
+        (
+            "linear_velocity: (0.0, 2e5, 0.0)",
+            "linear_velocity",
+            "1e5 m/s",
+        ),
+        (
+            "angular_velocity: (1e30, 0.0, 0.0)",
+            "angular_velocity",
+            "1e4 rad/s",
+        ),
+        ("mass: 1e25", "mass", "1e24 kg"),
+        ("density: 1e38", "density", "1e6 kg/m³"),
+    ];
+    for (fields, field, limit) in cases {
+        let (f, m) = message(&format!(
+            "Scene(bodies: [Body(name: \"b\", shape: Ball(radius: 1.0), {fields})])"
+        ));
+        assert_eq!(f, field, "{fields}");
+        assert!(m.contains(limit), "{fields}: {m}");
+    }
+    // Just inside the limits, the same bodies load.
+    for fields in [
+        "linear_velocity: (0.0, -9.9e4, 0.0)",
+        "angular_velocity: (0.0, 9.9e3, 0.0)",
+        "mass: 1e24",
+        "density: 1e6",
+    ] {
+        let text =
+            format!("Scene(bodies: [Body(name: \"b\", shape: Ball(radius: 1.0), {fields})])");
+        assert!(Scene::parse(&text, "ok.ron").is_ok(), "{fields}");
+    }
+}
+
+#[test]
+fn a_rotation_of_any_finite_length_is_normalised_without_overflow() {
+    // (0, 0, 0, 1e30) squared overflows f32: normalised naively it was NaN at the first step.
+    let scene = Scene::parse(
+        "Scene(gravity: (0.0, 0.0, 0.0), bodies: [Body(name: \"b\", shape: Cuboid(half_extents: (1.0, 1.0, 1.0)), rotation: (0.0, 0.0, 1e30, 1e30))])",
+        "big.ron",
+    )
+    .expect("a finite non-zero quaternion is a rotation");
+    let mut world = scene.build().expect("builds");
+    world.step(scene.dt).expect("steps");
+    let (_, _, body) = world.bodies().next().expect("one body");
+    let expected = jostle::Quat::from_rotation_z(std::f32::consts::FRAC_PI_2);
+    assert!(body.orientation.is_finite());
+    assert!(
+        body.orientation.dot(expected).abs() > 1.0 - 1e-6,
+        "{:?}",
+        body.orientation
+    );
+}
