@@ -20,8 +20,9 @@
 //!    [`SoftStepSettings::friction_in_bias_pass`] is set. After each pass the islands of
 //!    [`direct`] are solved exactly ([`direct::DirectIslands::correct`]), where Gauss-Seidel
 //!    would need about as many sweeps as their mass ratio. With [`PARALLEL_MIN_BATCHES`]
-//!    batches or more the substeps run on a team of threads, with the same result bit for
-//!    bit ([`team`]).
+//!    batches or more the substeps may run on a team of threads, with the same result bit
+//!    for bit ([`team`]), whenever the team has measured faster than one thread
+//!    (`ThreadChoice`).
 //! 3. restitution, skipped when no contact bounces: Newton's law at every point that approached
 //!    faster than the threshold, swept to convergence with the rest of the contacts, through
 //!    each body's inertia as it has turned since the start of the step
@@ -171,6 +172,70 @@ pub struct SoftStepResolver {
     /// Scratch of [`owner_bounds`], and its result.
     owners: Vec<u32>,
     bounds: Vec<u32>,
+    /// Whether the team or one thread runs the substeps faster here ([`ThreadChoice`]).
+    choice: ThreadChoice,
+}
+
+/// Steps between two trials of the mode not in use ([`ThreadChoice`]).
+const PROBE_INTERVAL: u32 = 32;
+
+/// Weight of a new measurement in a mode's running cost ([`ThreadChoice`]).
+const COST_WEIGHT: f64 = 0.25;
+
+/// Which runs a large step's substeps faster on this machine: the team of threads or the
+/// calling thread alone. Both give the same results bit for bit (`tests/threads.rs` of the
+/// `jostle` crate), so the choice is free to follow the clock: each mode's cost per contact
+/// point is a running average of its measured substep time, the cheaper one runs, and every
+/// [`PROBE_INTERVAL`] steps the other runs once to keep its figure current (the first run of
+/// each is not counted: it starts the helper threads or warms the caches). Measured why: on
+/// one two-core virtual machine the team took the 3D pyramid of 10 layers (315 batches) from
+/// 2.39 to 1.95 ms per step, on another from 2.29 to 2.7 (benches/RESULTS.md, "Threads
+/// chosen by the clock").
+#[derive(Clone, Copy, Debug, Default)]
+struct ThreadChoice {
+    /// Running cost per point (ns): one thread, the team.
+    cost: [Option<f64>; 2],
+    /// Runs of each mode so far (saturating).
+    runs: [u32; 2],
+    /// Steps since the mode not in use last ran.
+    since_probe: u32,
+}
+
+impl ThreadChoice {
+    const SOLO: usize = 0;
+    const TEAM: usize = 1;
+
+    /// Whether the next step's substeps run on the team.
+    fn use_team(&mut self) -> bool {
+        match self.cost {
+            [None, _] => false,
+            [_, None] => true,
+            [Some(solo), Some(team)] => {
+                let best = team < solo;
+                self.since_probe += 1;
+                if self.since_probe >= PROBE_INTERVAL {
+                    self.since_probe = 0;
+                    !best
+                } else {
+                    best
+                }
+            }
+        }
+    }
+
+    /// Records a run of the substeps: `team` or not, its wall time, over `points` points.
+    fn record(&mut self, team: bool, time: Duration, points: usize) {
+        let mode = if team { Self::TEAM } else { Self::SOLO };
+        self.runs[mode] = self.runs[mode].saturating_add(1);
+        if self.runs[mode] < 2 || points == 0 {
+            return;
+        }
+        let cost = time.as_nanos() as f64 / points as f64;
+        self.cost[mode] = Some(match self.cost[mode] {
+            Some(old) => old + COST_WEIGHT * (cost - old),
+            None => cost,
+        });
+    }
 }
 
 impl SoftStepResolver {
@@ -358,8 +423,9 @@ fn preload_update(manifold: solve::ManifoldEnd, rate: f32, target: f32, dt: f32)
     preload.min(manifold.compression).max(0.0)
 }
 
-/// Fewest batches for which a step's substeps run on more than one thread: below, the
-/// stages are too short for the threads' hand-overs to pay.
+/// Fewest batches for which a step's substeps may run on more than one thread: below, the
+/// stages are too short for the threads' hand-overs to pay. From there the clock decides
+/// (`ThreadChoice`).
 pub const PARALLEL_MIN_BATCHES: usize = 128;
 
 /// Batches per item of a team's stage ([`team`]).
@@ -647,6 +713,12 @@ impl Resolver for SoftStepResolver {
         } else {
             1
         };
+        let threads = if threads > 1 && self.choice.use_team() {
+            threads
+        } else {
+            1
+        };
+        let substeps_start = Instant::now();
         let direct_live = !self.direct.is_empty();
         if threads > 1 {
             owner_bounds(
@@ -718,6 +790,11 @@ impl Resolver for SoftStepResolver {
                 timing.get()
             }
         };
+        if self.batches.manifolds.len() >= PARALLEL_MIN_BATCHES && team::available_threads() > 1 {
+            let points = self.batches.points.len();
+            self.choice
+                .record(threads > 1, substeps_start.elapsed(), points);
+        }
         let [integrate_time, solve_time, mut relax_time] = times;
         stats.threads = threads as u32;
         let t = Instant::now();
@@ -802,5 +879,60 @@ impl Resolver for SoftStepResolver {
         stats.position_iterations = n.saturating_mul(substeps);
         stats.velocity_iterations = n.saturating_mul(substeps * self.settings.relax_iterations);
         stats
+    }
+}
+
+#[cfg(test)]
+mod thread_choice_tests {
+    use super::*;
+
+    /// Runs `steps` steps where the team costs `team` and one thread `solo` (ns per point),
+    /// returning how many ran on the team.
+    fn team_steps(choice: &mut ThreadChoice, steps: u32, solo: u64, team: u64) -> u32 {
+        let mut on_team = 0;
+        for _ in 0..steps {
+            let use_team = choice.use_team();
+            let cost = if use_team { team } else { solo };
+            choice.record(use_team, Duration::from_nanos(cost * 100), 100);
+            on_team += u32::from(use_team);
+        }
+        on_team
+    }
+
+    #[test]
+    fn the_faster_mode_runs_and_the_other_is_tried_now_and_then() {
+        let mut choice = ThreadChoice::default();
+        // Both measured within the first four steps, then the faster (the team) runs.
+        let on_team = team_steps(&mut choice, 4 + 10 * PROBE_INTERVAL, 2000, 1000);
+        let probes = 10;
+        assert_eq!(
+            on_team,
+            2 + 10 * PROBE_INTERVAL - probes,
+            "the team runs but for probes"
+        );
+        // The machine changes: one thread becomes faster, and the probes notice within a few
+        // of them (each moves the running cost a quarter of the way).
+        team_steps(&mut choice, 6 * PROBE_INTERVAL, 500, 1000);
+        let on_team = team_steps(&mut choice, 4 * PROBE_INTERVAL, 500, 1000);
+        assert!(
+            on_team <= 5,
+            "{on_team} of {} steps on the slower team",
+            4 * PROBE_INTERVAL
+        );
+    }
+
+    #[test]
+    fn the_first_run_of_each_mode_is_not_counted() {
+        let mut choice = ThreadChoice::default();
+        // A first team run paying for starting its threads does not condemn the team.
+        assert!(!choice.use_team());
+        choice.record(false, Duration::from_nanos(2000 * 100), 100);
+        assert!(!choice.use_team());
+        choice.record(false, Duration::from_nanos(2000 * 100), 100);
+        assert!(choice.use_team());
+        choice.record(true, Duration::from_millis(50), 100);
+        assert!(choice.use_team());
+        choice.record(true, Duration::from_nanos(1000 * 100), 100);
+        assert!(choice.use_team());
     }
 }
