@@ -23,8 +23,21 @@ pub const MAX_ANGULAR_SPEED: f32 = 1.0e4;
 /// the impulses that stop it stay finite in f32 (at most 3.4·10³⁸).
 pub const MAX_MASS: f32 = 1.0e24;
 
-/// The densest material (kg/m³): 10⁶, forty times osmium's.
-pub const MAX_DENSITY: f32 = 1.0e6;
+/// The farthest a body may be from the origin on any axis (m): 10⁶, where f32 still
+/// resolves 6 cm (the reach of shapes is bounded alike: `jostle_collide::shape::MAX_EXTENT`).
+pub const MAX_POSITION: f32 = 1.0e6;
+
+/// The strongest gravity a scene or snapshot may set (m/s²): 10⁵, ten thousand g (a
+/// scene's `gravity: (0, -1e30, 0)` made its bodies non-finite at the second step).
+pub const MAX_GRAVITY: f32 = 1.0e5;
+
+/// The longest time step (s): 10. A step of 10³⁰ s put every body out of f32's range.
+pub const MAX_DT: f32 = 10.0;
+
+/// The densest material (kg/m³): 10¹², far beyond any solid (osmium: 2.26·10⁴; the stability
+/// tests' 1:10,000 loads use 10⁷), so that `density` × volume stays finite; the mass it gives
+/// is then held to [`MAX_MASS`] (`density: 1e38` made the mass infinite).
+pub const MAX_DENSITY: f32 = 1.0e12;
 
 /// `q` scaled to unit length, for any finite non-zero quaternion however large or small its
 /// components (`Quat::normalize` squares them first: `(0, 0, 0, 1e30)` overflowed to NaN);
@@ -212,6 +225,13 @@ impl BodyDesc {
                 ))
             }
         };
+        let far = self.position.abs().max_element();
+        if far > MAX_POSITION {
+            return Err(err(
+                "position",
+                format!("{far:.3e} m from the origin is beyond the limit of {MAX_POSITION:e} m"),
+            ));
+        }
         at_most("linear_velocity", self.linear_velocity, MAX_SPEED, "m/s")?;
         at_most(
             "angular_velocity",

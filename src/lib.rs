@@ -37,7 +37,8 @@ pub mod view;
 pub mod world;
 
 pub use body_desc::{
-    BodyDesc, BodyError, MAX_ANGULAR_SPEED, MAX_DENSITY, MAX_MASS, MAX_SPEED, MassSpec,
+    BodyDesc, BodyError, MAX_ANGULAR_SPEED, MAX_DENSITY, MAX_DT, MAX_GRAVITY, MAX_MASS,
+    MAX_POSITION, MAX_SPEED, MassSpec,
 };
 pub use jostle_body::{BodyHandle, CcdMode, RigidBody};
 pub use jostle_collide::{

@@ -32,7 +32,7 @@ mod file {
     use super::ColliderRecord;
     use crate::settings::WorldSettings;
     use crate::world::World;
-    use jostle_body::BodySet;
+    use jostle_body::{BodySet, RigidBody};
     use jostle_collide::{Collider, NarrowPhase};
     use jostle_sleep::IslandSet;
     use serde::{Deserialize, Serialize};
@@ -163,9 +163,10 @@ mod file {
             ResolverChoice::SoftStep(s) => s.validate(),
         };
         resolver.map_err(|(field, message)| format!("settings.resolver.{field}: {message}"))?;
-        if !settings.gravity.is_finite() {
+        if !(settings.gravity.is_finite() && settings.gravity.length() <= crate::MAX_GRAVITY) {
             return Err(format!(
-                "settings.gravity: must be finite, got {}",
+                "settings.gravity: must be finite and at most {:e} m/s², got {}",
+                crate::MAX_GRAVITY,
                 settings.gravity
             ));
         }
@@ -173,6 +174,56 @@ mod file {
             .collide
             .validate()
             .map_err(|(field, message)| format!("settings.collide.{field}: {message}"))?;
+        Ok(())
+    }
+
+    /// A snapshot's body held to the limits a scene file's body is held to
+    /// ([`crate::MAX_SPEED`] and its neighbours), its pending force and torque to a change of
+    /// speed or spin within them over one step of `dt` (a hand-edited `force: (0, -1e30, 0)` or
+    /// `angular_velocity: (0, 1e30, 0)` went non-finite at the first step).
+    fn within_limits(body: &RigidBody, dt: f32) -> Result<(), (&'static str, String)> {
+        use crate::{MAX_ANGULAR_SPEED, MAX_MASS, MAX_POSITION, MAX_SPEED};
+        let check = |field, magnitude: f32, limit: f32, unit| {
+            if magnitude <= limit {
+                Ok(())
+            } else {
+                Err((
+                    field,
+                    format!("{magnitude:.3e} {unit} is above the limit of {limit:e} {unit}"),
+                ))
+            }
+        };
+        check(
+            "position",
+            body.position.abs().max_element(),
+            MAX_POSITION,
+            "m",
+        )?;
+        check(
+            "linear_velocity",
+            body.linear_velocity.length(),
+            MAX_SPEED,
+            "m/s",
+        )?;
+        check(
+            "angular_velocity",
+            body.angular_velocity.length(),
+            MAX_ANGULAR_SPEED,
+            "rad/s",
+        )?;
+        if !body.is_fixed() {
+            check("mass", body.mass(), MAX_MASS, "kg")?;
+            let dt = if dt.is_finite() && dt > 0.0 { dt } else { 1.0 };
+            let speed_change = body.force().length() * body.inv_mass() * dt;
+            check("force", speed_change, MAX_SPEED, "m/s of speed in one step")?;
+            let spin_change = (body.inv_inertia_world() * body.torque()).length() * dt;
+            check(
+                "torque",
+                spin_change,
+                MAX_ANGULAR_SPEED,
+                "rad/s of spin in one step",
+            )?;
+        }
         Ok(())
     }
 
@@ -233,6 +284,58 @@ mod file {
                 return Err(invalid("fewer body names than body slots".into()));
             }
             world.names = snapshot.names;
+            let slots: Vec<_> = world.bodies.iter().map(|(h, _)| h).collect();
+            for handle in slots {
+                let name = &world.names[handle.index() as usize];
+                if let Some(body) = world.bodies.get_mut(handle)
+                    && let Err((field, message)) =
+                        body.check().and_then(|()| within_limits(body, snapshot.dt))
+                {
+                    return Err(invalid(format!(
+                        "body {} \"{name}\": field `{field}`: {message}",
+                        handle.index()
+                    )));
+                }
+            }
+            for (i, record) in world.records.iter().enumerate() {
+                let m = record.material;
+                if !(m.friction.is_finite() && m.friction >= 0.0) {
+                    return Err(invalid(format!(
+                        "collider {i}: material.friction: must be finite and >= 0, got {}",
+                        m.friction
+                    )));
+                }
+                if !(m.restitution.is_finite() && (0.0..=1.0).contains(&m.restitution)) {
+                    return Err(invalid(format!(
+                        "collider {i}: material.restitution: must be in [0, 1], got {}",
+                        m.restitution
+                    )));
+                }
+                let pose = record.local_pose;
+                let reach = pose.translation.abs().max_element();
+                let within = reach <= jostle_collide::shape::MAX_EXTENT;
+                let unit = (pose.rotation.length() - 1.0).abs() < 1e-3;
+                if !(within && pose.rotation.is_finite() && unit) {
+                    return Err(invalid(format!(
+                        "collider {i}: local_pose: must be within {:e} m and turn by a unit quaternion",
+                        jostle_collide::shape::MAX_EXTENT
+                    )));
+                }
+                let fixed = world.bodies.get(record.body).is_some_and(|b| b.is_fixed());
+                if record.shape.is_unbounded() && !fixed {
+                    return Err(invalid(format!(
+                        "collider {i}: a half-space has no finite mass: its body {} must be fixed",
+                        record.body
+                    )));
+                }
+            }
+            let inv_mass = |c: &Collider| world.bodies.get(c.body).map_or(0.0, |b| b.inv_mass());
+            snapshot
+                .narrow
+                .check(&world.colliders, |c1, c2| {
+                    crate::MAX_SPEED / (inv_mass(c1) + inv_mass(c2))
+                })
+                .map_err(|e| invalid(format!("narrow: {e}")))?;
             world.narrow = snapshot.narrow;
             world.narrow.rebind_shapes(&world.colliders);
             snapshot

@@ -22,8 +22,8 @@ use thiserror::Error;
 /// Why a step or an API call was refused.
 #[derive(Clone, Debug, Error, PartialEq)]
 pub enum StepError {
-    /// The time step must be finite and > 0.
-    #[error("time step must be finite and > 0, got {0}")]
+    /// The time step must be finite, > 0 and at most [`crate::MAX_DT`].
+    #[error("time step must be in (0, 10] s, got {0}")]
     InvalidDt(f32),
     /// The handle is stale (its body was removed) or was never issued by this world.
     #[error("invalid or stale body handle {0}")]
@@ -35,6 +35,17 @@ pub enum StepError {
         what: &'static str,
         /// The value, formatted.
         value: String,
+    },
+    /// A value given through the API is beyond what the engine holds
+    /// ([`crate::MAX_SPEED`], [`crate::MAX_ANGULAR_SPEED`]).
+    #[error("{what} {value} is above the limit of {limit}")]
+    OutOfRange {
+        /// What was given (`linear velocity`, `angular velocity`).
+        what: &'static str,
+        /// The value's magnitude, formatted.
+        value: String,
+        /// The limit, with its unit.
+        limit: String,
     },
 }
 
@@ -312,6 +323,24 @@ impl World {
     ) -> Result<(), StepError> {
         Self::finite("linear velocity", linear)?;
         Self::finite("angular velocity", angular)?;
+        let limit = |what, v: Vec3, limit: f32, unit| {
+            if v.length() <= limit {
+                Ok(())
+            } else {
+                Err(StepError::OutOfRange {
+                    what,
+                    value: format!("{:.3e} {unit}", v.length()),
+                    limit: format!("{limit:e} {unit}"),
+                })
+            }
+        };
+        limit("linear velocity", linear, crate::MAX_SPEED, "m/s")?;
+        limit(
+            "angular velocity",
+            angular,
+            crate::MAX_ANGULAR_SPEED,
+            "rad/s",
+        )?;
         let body = self.body_mut_awake(handle)?;
         body.linear_velocity = linear;
         if !body.is_rotation_locked() {
@@ -427,7 +456,7 @@ impl World {
     /// 7. scatter — results back to the bodies, impulses back to the manifolds, quarantine;
     /// 8. sleep — motion averages, islands, resting islands go to sleep.
     pub fn step(&mut self, dt: f32) -> Result<StepReport, StepError> {
-        if !(dt.is_finite() && dt > 0.0) {
+        if !(dt.is_finite() && dt > 0.0 && dt <= crate::MAX_DT) {
             return Err(StepError::InvalidDt(dt));
         }
         let start = Instant::now();

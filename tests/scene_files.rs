@@ -305,7 +305,7 @@ fn values_beyond_what_f32_physics_holds_name_the_field_and_the_limit() {
             "1e4 rad/s",
         ),
         ("mass: 1e25", "mass", "1e24 kg"),
-        ("density: 1e38", "density", "1e6 kg/m³"),
+        ("density: 1e38", "density", "1e12 kg/m³"),
     ];
     for (fields, field, limit) in cases {
         let (f, m) = message(&format!(
@@ -319,7 +319,7 @@ fn values_beyond_what_f32_physics_holds_name_the_field_and_the_limit() {
         "linear_velocity: (0.0, -9.9e4, 0.0)",
         "angular_velocity: (0.0, 9.9e3, 0.0)",
         "mass: 1e24",
-        "density: 1e6",
+        "density: 1e12",
     ] {
         let text =
             format!("Scene(bodies: [Body(name: \"b\", shape: Ball(radius: 1.0), {fields})])");

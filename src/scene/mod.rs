@@ -293,16 +293,20 @@ impl Scene {
             field: field.into(),
             message,
         };
-        if !self.gravity.is_finite() {
+        if !(self.gravity.is_finite() && self.gravity.length() <= crate::MAX_GRAVITY) {
             return Err(setting(
                 "gravity",
-                format!("must be finite, got {}", self.gravity),
+                format!(
+                    "must be finite and at most {:e} m/s², got {}",
+                    crate::MAX_GRAVITY,
+                    self.gravity
+                ),
             ));
         }
-        if !(self.dt.is_finite() && self.dt > 0.0) {
+        if !(self.dt.is_finite() && self.dt > 0.0 && self.dt <= crate::MAX_DT) {
             return Err(setting(
                 "dt",
-                format!("must be finite and > 0, got {}", self.dt),
+                format!("must be in (0, {}] s, got {}", crate::MAX_DT, self.dt),
             ));
         }
         if let Some(s) = &self.sleep {

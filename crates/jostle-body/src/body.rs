@@ -223,6 +223,105 @@ impl RigidBody {
         self.inv_inertia_world = world_inverse_inertia(self.orientation, self.inv_inertia_body);
     }
 
+    /// Checks a body that did not come from [`RigidBody::dynamic`] or [`RigidBody::fixed`] (a
+    /// snapshot read back): every number finite and in its domain, a unit orientation, mass
+    /// and inverse mass that agree, a fixed body with no inverse mass or inertia, and
+    /// refreshes the world inverse inertia from the body-space one rather than trusting it.
+    /// The error names the field and what is wrong.
+    pub fn check(&mut self) -> Result<(), (&'static str, String)> {
+        let vector = |field: &'static str, v: Vec3| {
+            if v.is_finite() {
+                Ok(())
+            } else {
+                Err((field, format!("must be finite, got {v}")))
+            }
+        };
+        vector("position", self.position)?;
+        vector("linear_velocity", self.linear_velocity)?;
+        vector("angular_velocity", self.angular_velocity)?;
+        vector("last_acceleration", self.last_acceleration)?;
+        vector("force", self.force)?;
+        vector("torque", self.torque)?;
+        let length = self.orientation.length();
+        if !(self.orientation.is_finite() && (length - 1.0).abs() < 1e-3) {
+            return Err((
+                "orientation",
+                format!("must be a unit quaternion, got {:?}", self.orientation),
+            ));
+        }
+        let non_negative = |field: &'static str, x: f32| {
+            if x.is_finite() && x >= 0.0 {
+                Ok(())
+            } else {
+                Err((field, format!("must be finite and >= 0, got {x}")))
+            }
+        };
+        non_negative("linear_damping", self.linear_damping)?;
+        non_negative("angular_damping", self.angular_damping)?;
+        non_negative("sleep.motion", self.sleep.motion)?;
+        let finite = |m: &Mat3| m.to_cols_array().iter().all(|x| x.is_finite());
+        if self.fixed {
+            if self.inv_mass != 0.0 || self.inv_inertia_body != Mat3::ZERO {
+                return Err((
+                    "fixed",
+                    format!(
+                        "a fixed body has no inverse mass or inertia, got inv_mass {}",
+                        self.inv_mass
+                    ),
+                ));
+            }
+        } else {
+            if !(self.mass.is_finite() && self.mass > 0.0) {
+                return Err(("mass", format!("must be finite and > 0, got {}", self.mass)));
+            }
+            let agree = (self.inv_mass * self.mass - 1.0).abs() < 1e-3;
+            if !(self.inv_mass.is_finite() && self.inv_mass > 0.0 && agree) {
+                return Err((
+                    "inv_mass",
+                    format!(
+                        "must be 1/mass = {}, got {}",
+                        1.0 / self.mass,
+                        self.inv_mass
+                    ),
+                ));
+            }
+            let diagonal = |m: &Mat3| Vec3::new(m.x_axis.x, m.y_axis.y, m.z_axis.z);
+            if !(finite(&self.inertia_body) && diagonal(&self.inertia_body).min_element() >= 0.0) {
+                return Err((
+                    "inertia_body",
+                    format!(
+                        "must be finite with a diagonal >= 0, got {}",
+                        self.inertia_body
+                    ),
+                ));
+            }
+            let inverse = &self.inv_inertia_body;
+            // The inverse is the tensor's (to f32 rounding), or zero for a rotation-locked
+            // body (or a tensor not recorded, in older snapshots).
+            let identity = self.inertia_body * *inverse;
+            let inverts = *inverse == Mat3::ZERO
+                || self.inertia_body == Mat3::ZERO
+                || (identity - Mat3::IDENTITY)
+                    .to_cols_array()
+                    .iter()
+                    .all(|x| x.abs() < 1e-3);
+            if !inverts {
+                return Err((
+                    "inv_inertia_body",
+                    format!("must be the inverse of inertia_body, got {inverse}"),
+                ));
+            }
+            if !(finite(inverse) && symmetric_semi_definite(inverse)) {
+                return Err((
+                    "inv_inertia_body",
+                    format!("must be finite, symmetric and positive semi-definite, got {inverse}"),
+                ));
+            }
+        }
+        self.update_world_inertia();
+        Ok(())
+    }
+
     /// Force accumulated for the next step (N).
     pub fn force(&self) -> Vec3 {
         self.force
@@ -349,4 +448,22 @@ mod tests {
                 .is_err()
         );
     }
+}
+
+/// Whether `m` is symmetric and positive semi-definite, to f32 rounding (Sylvester's
+/// criterion on the leading minors, each allowed a relative error; a rotation-locked body's
+/// zero matrix passes).
+fn symmetric_semi_definite(m: &Mat3) -> bool {
+    let scale = m.to_cols_array().iter().fold(0.0f32, |a, x| a.max(x.abs()));
+    if scale == 0.0 {
+        return true;
+    }
+    let a = *m * (1.0 / scale);
+    let tolerance = 1e-4;
+    let symmetric = (a.x_axis.y - a.y_axis.x).abs() <= tolerance
+        && (a.x_axis.z - a.z_axis.x).abs() <= tolerance
+        && (a.y_axis.z - a.z_axis.y).abs() <= tolerance;
+    let minor2 = a.x_axis.x * a.y_axis.y - a.x_axis.y * a.y_axis.x;
+    let diagonal = a.x_axis.x.min(a.y_axis.y).min(a.z_axis.z);
+    symmetric && diagonal >= -tolerance && minor2 >= -tolerance && a.determinant() >= -tolerance
 }

@@ -17,6 +17,7 @@ use crate::collider::{Collider, ColliderSet};
 use crate::material::Material;
 use crate::reduce::reduce_manifold;
 use crate::settings::CollideSettings;
+use crate::shape::MAX_EXTENT;
 use jostle_body::{BodyHandle, BodySet};
 use jostle_math::Vec3;
 use parry3d::math::Pose;
@@ -216,6 +217,109 @@ impl NarrowPhase {
                 computed.shapes = (shape_id(c1), shape_id(c2));
             }
         }
+    }
+
+    /// Checks a narrow phase read back from a snapshot against `colliders`: every pair's
+    /// colliders exist, every contact index is in range, and every number a step reads back
+    /// (points, depths, carried impulses and preloads, held frames) is finite and in its
+    /// domain. A snapshot's `impulse: (526, NaN, -3.7)` made a body non-finite at the first
+    /// step. The error names the pair, manifold and point, and the field.
+    pub fn check(
+        &self,
+        colliders: &ColliderSet,
+        max_impulse: impl Fn(&Collider, &Collider) -> f32,
+    ) -> Result<(), String> {
+        // Finite and within the reach of any shape (`shape::MAX_EXTENT`).
+        let vector = |v: Vec3| v.is_finite() && v.abs().max_element() <= 2.0 * MAX_EXTENT;
+        for (i, state) in self.pairs.iter().enumerate() {
+            let (Some(c1), Some(c2)) = (colliders.get(state.pair.0), colliders.get(state.pair.1))
+            else {
+                return Err(format!(
+                    "pairs[{i}]: collider {} or {} does not exist",
+                    state.pair.0, state.pair.1
+                ));
+            };
+            let limit = max_impulse(c1, c2);
+            for (j, manifold) in state.manifolds.iter().enumerate() {
+                let at = |k: usize, field: &str| {
+                    format!("pairs[{i}].manifolds[{j}].points[{k}].{field}")
+                };
+                if !(vector(manifold.local_n1) && vector(manifold.local_n2)) {
+                    return Err(format!("pairs[{i}].manifolds[{j}]: normals must be finite"));
+                }
+                for (k, p) in manifold.points.iter().enumerate() {
+                    let depth = p.dist.abs() <= 2.0 * MAX_EXTENT;
+                    if !(vector(p.local_p1) && vector(p.local_p2) && depth) {
+                        return Err(format!(
+                            "{}: must be finite",
+                            at(k, "local_p1/local_p2/dist")
+                        ));
+                    }
+                    let d = &p.data;
+                    if !(d.impulse.is_finite() && d.impulse.length() <= limit) {
+                        return Err(format!(
+                            "{}: must be finite and at most {limit:e} N·s (what stops the pair at \
+                             the speed limit), got {}",
+                            at(k, "data.impulse"),
+                            d.impulse
+                        ));
+                    }
+                    if !(d.preload.is_finite() && d.preload >= 0.0) {
+                        return Err(format!(
+                            "{}: must be finite and >= 0, got {}",
+                            at(k, "data.preload"),
+                            d.preload
+                        ));
+                    }
+                    if let Some(f) = &d.frame {
+                        let unit = f.normal.is_finite() && (f.normal.length() - 1.0).abs() < 1e-3;
+                        if !(unit && vector(f.r_a) && vector(f.r_b)) {
+                            return Err(format!(
+                                "{}: must be a unit normal and finite lever arms",
+                                at(k, "data.frame")
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        for (i, slot) in self.slots.iter().enumerate() {
+            let point = self
+                .pairs
+                .get(slot.pair as usize)
+                .and_then(|s| s.manifolds.get(slot.manifold as usize))
+                .and_then(|m| m.points.get(slot.point as usize));
+            if point.is_none() {
+                return Err(format!(
+                    "slots[{i}]: no point at pair {}, manifold {}, point {}",
+                    slot.pair, slot.manifold, slot.point
+                ));
+            }
+        }
+        if self.slots.len() != self.contacts.len() {
+            return Err(format!(
+                "{} slots for {} contacts",
+                self.slots.len(),
+                self.contacts.len()
+            ));
+        }
+        for (i, c) in self.contacts.iter().enumerate() {
+            let finite = c.point.is_finite()
+                && c.point_b.is_finite()
+                && c.impulse.is_finite()
+                && c.penetration.is_finite()
+                && c.preload.is_finite()
+                && c.preload >= 0.0;
+            let unit = c.normal.is_finite() && (c.normal.length() - 1.0).abs() < 1e-3;
+            let material =
+                c.friction.is_finite() && c.friction >= 0.0 && (0.0..=1.0).contains(&c.restitution);
+            if !(finite && unit && material) {
+                return Err(format!(
+                    "contacts[{i}]: a number is not finite or out of its domain"
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// An empty narrow phase.

@@ -180,6 +180,25 @@ impl ShapeDesc {
     /// degenerate triangle, an empty compound or a compound part that is not a bounded convex
     /// shape. Never panics.
     pub fn build(&self) -> Result<SharedShape, ShapeError> {
+        let shape = self.build_unbounded_size()?;
+        if !matches!(self, Self::HalfSpace { .. }) {
+            let aabb = shape.compute_local_aabb();
+            let reach = aabb.mins.abs().max(aabb.maxs.abs()).max_element();
+            if !(reach <= MAX_EXTENT) {
+                return Err(ShapeError::invalid(
+                    "size",
+                    format!(
+                        "the {} reaches {reach:.3e} m from its origin, beyond the limit of \
+                         {MAX_EXTENT:e} m",
+                        self.kind()
+                    ),
+                ));
+            }
+        }
+        Ok(shape)
+    }
+
+    fn build_unbounded_size(&self) -> Result<SharedShape, ShapeError> {
         match self {
             Self::Ball { radius } => {
                 positive("radius", *radius)?;
@@ -228,6 +247,11 @@ impl ShapeDesc {
         }
     }
 }
+
+/// How far (m) a shape may reach from its origin: 10⁶ m, where f32 still resolves 6 cm;
+/// beyond it contacts are rounding noise (a snapshot's `half_extents: (0.5, 0.5, 1e30)` went
+/// non-finite at the first step).
+pub const MAX_EXTENT: f32 = 1.0e6;
 
 fn positive(field: &'static str, value: f32) -> Result<(), ShapeError> {
     if value.is_finite() && value > 0.0 {

@@ -184,6 +184,11 @@ impl SoftStepSettings {
     /// operations per solve, two solves per substep.
     pub const MAX_DIRECT_ROWS: u32 = 256;
 
+    /// The most `substeps`, `relax_iterations`, `restitution_iterations` and `normal_sweeps`
+    /// accepted: 1,024 passes over every contact per step, already a thousand times the cost of
+    /// the defaults.
+    pub const MAX_PASSES: u32 = 1024;
+
     /// Normal velocity correction (m/s) below which a restitution sweep counts as converged.
     pub const RESTITUTION_TOLERANCE: f32 = 1e-5;
 
@@ -200,6 +205,21 @@ impl SoftStepSettings {
         };
         if self.substeps == 0 {
             return Err(("substeps", "must be >= 1, got 0".into()));
+        }
+        // Each of these runs that many passes over every contact each step: a snapshot's
+        // `substeps: 4294967295` never finished its first step.
+        for (field, count) in [
+            ("substeps", self.substeps),
+            ("relax_iterations", self.relax_iterations),
+            ("restitution_iterations", self.restitution_iterations),
+            ("normal_sweeps", self.normal_sweeps),
+        ] {
+            if count > Self::MAX_PASSES {
+                return Err((
+                    field,
+                    format!("must be <= {}, got {count}", Self::MAX_PASSES),
+                ));
+            }
         }
         // A 0 Hz contact has no stiffness at all: bodies sink into each other for good.
         let positive = |field: &'static str, x: f32| {

@@ -1,0 +1,256 @@
+//! Hostile input (issue 16): scene and snapshot text with numbers replaced by NaN, infinities,
+//! huge, tiny, negative and out-of-range values, or cut short, never panics and never yields a
+//! world that goes non-finite. Either loading refuses it with an error, or the world it builds
+//! steps with every body finite and none quarantined.
+//!
+//! Cases: `PROPTEST_CASES` (default 128 per test here), drawn from a fixed seed unless
+//! `PROPTEST_RNG_SEED` names one. `jostle run` reads files through the same calls
+//! (`Scene::parse` and `build`, `Snapshot::parse` and `World::from_snapshot`).
+
+use jostle::World;
+use jostle::scene::Scene;
+use jostle::snapshot::Snapshot;
+use proptest::prelude::*;
+use proptest::test_runner::RngSeed;
+use std::sync::OnceLock;
+
+/// What may replace a number.
+const REPLACEMENTS: [&str; 14] = [
+    "NaN",
+    "inf",
+    "-inf",
+    "-1",
+    "0",
+    "1e30",
+    "-1e30",
+    "1e-30",
+    "4294967295",
+    "18446744073709551615",
+    "99",
+    "3",
+    "-0.5",
+    "1e38",
+];
+
+fn config(cases: u32) -> ProptestConfig {
+    let base = ProptestConfig::default();
+    let rng_seed = match base.rng_seed {
+        RngSeed::Random => RngSeed::Fixed(0x686f_7374_696c),
+        seed => seed,
+    };
+    ProptestConfig {
+        cases: std::env::var("PROPTEST_CASES")
+            .ok()
+            .and_then(|c| c.parse().ok())
+            .unwrap_or(cases),
+        rng_seed,
+        ..base
+    }
+}
+
+/// Byte ranges of the numbers in `text`.
+fn numbers(text: &str) -> Vec<(usize, usize)> {
+    let bytes = text.as_bytes();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < bytes.len() {
+        let starts = bytes[i].is_ascii_digit()
+            || (bytes[i] == b'-' && bytes.get(i + 1).is_some_and(u8::is_ascii_digit));
+        let in_word = i > 0 && (bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'_');
+        if starts && !in_word {
+            let start = i;
+            i += 1;
+            while i < bytes.len()
+                && (bytes[i].is_ascii_digit() || matches!(bytes[i], b'.' | b'e' | b'-'))
+            {
+                i += 1;
+            }
+            out.push((start, i));
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
+/// `text` with the numbers picked by `picks` (fractions of the list) replaced, or, when
+/// `cut` is below 1, cut at that fraction of its length.
+fn mutate(text: &str, picks: &[(f64, usize)], cut: f64) -> String {
+    if cut < 1.0 {
+        let mut end = (text.len() as f64 * cut) as usize;
+        while !text.is_char_boundary(end) {
+            end -= 1;
+        }
+        return text[..end].to_string();
+    }
+    let spans = numbers(text);
+    let mut chosen: Vec<(usize, usize, &str)> = picks
+        .iter()
+        .map(|&(at, r)| {
+            let (s, e) = spans[((at * spans.len() as f64) as usize).min(spans.len() - 1)];
+            (s, e, REPLACEMENTS[r % REPLACEMENTS.len()])
+        })
+        .collect();
+    chosen.sort_by_key(|c| std::cmp::Reverse(c.0));
+    chosen.dedup_by_key(|c| c.0);
+    let mut out = text.to_string();
+    for (s, e, r) in chosen {
+        out.replace_range(s..e, r);
+    }
+    out
+}
+
+/// Steps `world` a few times: every step either refuses (a bad time step) or leaves every
+/// body finite, none quarantined.
+fn steps_stay_finite(mut world: World, dt: f32, text: &str) {
+    for _ in 0..4 {
+        match world.step(dt) {
+            Ok(report) => assert!(
+                report.quarantined.is_empty(),
+                "{:?} went non-finite from:\n{text}",
+                report.quarantined
+            ),
+            Err(_) => return,
+        }
+    }
+    for (_, name, body) in world.bodies() {
+        assert!(body.is_finite(), "{name} is not finite, from:\n{text}");
+    }
+}
+
+const SCENE: &str = include_str!("../assets/stack_15.ron");
+
+/// A snapshot of the 15-box stack after 30 steps, with contacts and carried impulses.
+fn snapshot_text() -> &'static str {
+    static TEXT: OnceLock<String> = OnceLock::new();
+    TEXT.get_or_init(|| {
+        let scene = Scene::parse(SCENE, "stack_15.ron").expect("the asset loads");
+        let mut world = scene.build().expect("builds");
+        for _ in 0..30 {
+            world.step(scene.dt).expect("steps");
+        }
+        let config = ron::ser::PrettyConfig::default().struct_names(true);
+        ron::ser::to_string_pretty(&world.snapshot("stack 15", scene.dt), config)
+            .expect("serialises")
+    })
+}
+
+fn mutation() -> impl Strategy<Value = (Vec<(f64, usize)>, f64)> {
+    (
+        prop::collection::vec((0.0f64..1.0, 0usize..REPLACEMENTS.len()), 1..4),
+        prop_oneof![4 => Just(1.0f64), 1 => 0.0f64..1.0],
+    )
+}
+
+proptest! {
+    #![proptest_config(config(128))]
+
+    #[test]
+    fn mutated_scene_files_are_refused_or_run_finite((picks, cut) in mutation()) {
+        let text = mutate(SCENE, &picks, cut);
+        if let Ok(scene) = Scene::parse(&text, "mutated.ron")
+            && let Ok(world) = scene.build()
+        {
+            steps_stay_finite(world, scene.dt, &text);
+        }
+    }
+
+    #[test]
+    fn mutated_snapshots_are_refused_or_run_finite((picks, cut) in mutation()) {
+        let text = mutate(snapshot_text(), &picks, cut);
+        if let Ok(snapshot) = Snapshot::parse(&text, "mutated.ron") {
+            let dt = snapshot.dt;
+            if let Ok(world) = World::from_snapshot(snapshot) {
+                steps_stay_finite(world, dt, &text);
+            }
+        }
+    }
+}
+
+#[test]
+fn the_mutations_reach_the_numbers() {
+    let text = snapshot_text();
+    // Unmutated, the snapshot and the scene load and run.
+    let snapshot = Snapshot::parse(text, "stack.ron").expect("the snapshot parses");
+    let dt = snapshot.dt;
+    steps_stay_finite(World::from_snapshot(snapshot).expect("restores"), dt, text);
+    let scene = Scene::parse(SCENE, "stack_15.ron").expect("the scene parses");
+    steps_stay_finite(scene.build().expect("builds"), scene.dt, SCENE);
+    assert!(numbers(text).len() > 1000);
+    let mutated = mutate(text, &[(0.5, 0)], 1.0);
+    assert_ne!(mutated, text);
+    assert!(mutated.contains("NaN"));
+}
+
+/// The error `World::from_snapshot` gives for the snapshot text with the first number after
+/// `field` (itself the first after `after`) replaced by `to`.
+fn snapshot_error(after: &str, field: &str, to: &str) -> String {
+    let text = snapshot_text();
+    let start = text.find(after).expect("anchor present");
+    let at = start + text[start..].find(field).expect("field present");
+    let (s, e) = numbers(text)
+        .into_iter()
+        .find(|&(s, _)| s >= at)
+        .expect("a number follows");
+    let mut edited = text.to_string();
+    edited.replace_range(s..e, to);
+    let snapshot = Snapshot::parse(&edited, "edited.ron").expect("still parses");
+    match World::from_snapshot(snapshot) {
+        Ok(_) => panic!("accepted {field} {to}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn a_snapshot_names_the_body_or_collider_and_the_field_it_refuses() {
+    // After `mass: 999` come a box's own fields; after the fixed ground's last field comes the
+    // first box.
+    let cases = [
+        ("mass: 999", "inv_mass: ", "-0.5", "`inv_mass`"),
+        (
+            "fixed: true",
+            "linear_velocity: ",
+            "1e30",
+            "`linear_velocity`",
+        ),
+        (
+            "mass: 999",
+            "inv_inertia_body: ",
+            "99.0",
+            "`inv_inertia_body`",
+        ),
+        ("bodies:", "inv_mass: ", "1.0", "`fixed`"),
+        ("colliders:", "restitution: ", "5.0", "restitution"),
+        ("resolver:", "substeps: ", "4294967", "substeps"),
+        ("narrow:", "impulse: ", "NaN", "impulse"),
+        ("narrow:", "local_p2: ", "1e30", "local_p"),
+    ];
+    for (after, field, to, named) in cases {
+        let e = snapshot_error(after, field, to);
+        assert!(e.contains(named), "{field} {to}: {e}");
+    }
+}
+
+#[test]
+fn api_values_beyond_the_limits_are_refused() {
+    use jostle::{BodyDesc, ShapeDesc, StepError, Vec3, WorldSettings};
+    let mut world = World::new(WorldSettings::default());
+    let h = world
+        .add_body(BodyDesc::dynamic("ball", ShapeDesc::Ball { radius: 0.5 }))
+        .expect("adds");
+    assert!(matches!(
+        world.set_velocity(h, Vec3::new(0.0, 2.0e5, 0.0), Vec3::ZERO),
+        Err(StepError::OutOfRange { .. })
+    ));
+    assert!(matches!(
+        world.set_velocity(h, Vec3::ZERO, Vec3::new(0.0, 0.0, 2.0e4)),
+        Err(StepError::OutOfRange { .. })
+    ));
+    assert!(
+        world
+            .set_velocity(h, Vec3::new(0.0, 9.0e4, 0.0), Vec3::ZERO)
+            .is_ok()
+    );
+    assert!(matches!(world.step(11.0), Err(StepError::InvalidDt(_))));
+    assert!(world.step(10.0).is_ok());
+}
