@@ -184,7 +184,7 @@ impl ShapeDesc {
         if !matches!(self, Self::HalfSpace { .. }) {
             let aabb = shape.compute_local_aabb();
             let reach = aabb.mins.abs().max(aabb.maxs.abs()).max_element();
-            if !(reach <= MAX_EXTENT) {
+            if reach.is_nan() || reach > MAX_EXTENT {
                 return Err(ShapeError::invalid(
                     "size",
                     format!(
