@@ -396,6 +396,24 @@ impl RigidBody {
     }
 }
 
+/// Whether `m` is symmetric and positive semi-definite, to f32 rounding (Sylvester's
+/// criterion on the leading minors, each allowed a relative error; a rotation-locked body's
+/// zero matrix passes).
+fn symmetric_semi_definite(m: &Mat3) -> bool {
+    let scale = m.to_cols_array().iter().fold(0.0f32, |a, x| a.max(x.abs()));
+    if scale == 0.0 {
+        return true;
+    }
+    let a = *m * (1.0 / scale);
+    let tolerance = 1e-4;
+    let symmetric = (a.x_axis.y - a.y_axis.x).abs() <= tolerance
+        && (a.x_axis.z - a.z_axis.x).abs() <= tolerance
+        && (a.y_axis.z - a.z_axis.y).abs() <= tolerance;
+    let minor2 = a.x_axis.x * a.y_axis.y - a.x_axis.y * a.y_axis.x;
+    let diagonal = a.x_axis.x.min(a.y_axis.y).min(a.z_axis.z);
+    symmetric && diagonal >= -tolerance && minor2 >= -tolerance && a.determinant() >= -tolerance
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
@@ -448,22 +466,4 @@ mod tests {
                 .is_err()
         );
     }
-}
-
-/// Whether `m` is symmetric and positive semi-definite, to f32 rounding (Sylvester's
-/// criterion on the leading minors, each allowed a relative error; a rotation-locked body's
-/// zero matrix passes).
-fn symmetric_semi_definite(m: &Mat3) -> bool {
-    let scale = m.to_cols_array().iter().fold(0.0f32, |a, x| a.max(x.abs()));
-    if scale == 0.0 {
-        return true;
-    }
-    let a = *m * (1.0 / scale);
-    let tolerance = 1e-4;
-    let symmetric = (a.x_axis.y - a.y_axis.x).abs() <= tolerance
-        && (a.x_axis.z - a.z_axis.x).abs() <= tolerance
-        && (a.y_axis.z - a.z_axis.y).abs() <= tolerance;
-    let minor2 = a.x_axis.x * a.y_axis.y - a.x_axis.y * a.y_axis.x;
-    let diagonal = a.x_axis.x.min(a.y_axis.y).min(a.z_axis.z);
-    symmetric && diagonal >= -tolerance && minor2 >= -tolerance && a.determinant() >= -tolerance
 }
