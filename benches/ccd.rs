@@ -1,5 +1,5 @@
-//! CCD costs nothing for bodies that are slow for their size (DESIGN.md, "Skip what a scene does
-//! not need"; issue 10): ms/step of the 20-row pyramid (210 boxes, no fast body) with continuous
+//! CCD costs nothing for bodies that are slow for their size (benches/RESULTS.md, "Skip what a
+//! scene does not need"; issue 10): ms/step of the 20-row pyramid (210 boxes, no fast body) with continuous
 //! collision detection enabled against the same scene with it disabled. Sleeping is off in this
 //! scene, so every step runs the CCD motion test of all 210 boxes. Both worlds are settled for
 //! 10 s first, so the two measure the same resting state. Run: `cargo bench --bench ccd`.

@@ -1,4 +1,4 @@
-//! "Skip what a scene does not need", measured (DESIGN.md; issue 7): bench pairs that run the
+//! "Skip what a scene does not need", measured (benches/RESULTS.md; issue 7): bench pairs that run the
 //! same work with and without the need for a piece of it. Sleeping islands and CCD have their
 //! own benches (benches/sleep.rs, benches/ccd.rs); this one holds the rest.
 //!

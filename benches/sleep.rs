@@ -1,6 +1,6 @@
 //! Sleeping islands cost nothing: ms/step of 1,000 boxes in 200 separate piles once every
-//! island sleeps, against the same settled scene with sleeping disabled (DESIGN.md, "Skip what a
-//! scene does not need"). Run: `cargo bench --bench sleep`.
+//! island sleeps, against the same settled scene with sleeping disabled (benches/RESULTS.md, "Sleeping
+//! islands cost nothing"). Run: `cargo bench --bench sleep`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use jostle::World;

@@ -1,5 +1,5 @@
-//! The side-by-side with rapier3d 0.36 (issue 6's last acceptance item, issue 7, DESIGN.md
-//! "Benchmarks"): stacking scenes of boxes on the ground (μ 0.6, density 1000 kg/m³, sleeping
+//! The side-by-side with rapier3d 0.36 (issue 6's last acceptance item, issue 7;
+//! benches/RESULTS.md): stacking scenes of boxes on the ground (μ 0.6, density 1000 kg/m³, sleeping
 //! disabled) built in rapier3d with its defaults (dt 1/60, 4 solver iterations, 1 substep) and
 //! in jostle, measured in the same run:
 //!

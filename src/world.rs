@@ -1,7 +1,7 @@
 //! `World`: bodies, colliders, the resolver and the step pipeline.
 //!
-//! Start reading at [`World::step`]: one linear pipeline of named, timed stages (DESIGN.md,
-//! "The step pipeline"); each stage is a small function in `stages.rs` over exactly the data it
+//! Start reading at [`World::step`]: one linear pipeline of named, timed stages (ARCHITECTURE.md,
+//! "The step"); each stage is a small function in `stages.rs` over exactly the data it
 //! touches.
 
 use crate::body_desc::{BodyDesc, BodyError, MAX_MASS, MassSpec, shape_error, unit_rotation};
@@ -440,7 +440,7 @@ impl World {
         jostle_collide::ray_cast(&self.colliders, &self.bodies, origin, dir, max_distance)
     }
 
-    /// Advances the world by `dt` seconds: the pipeline of DESIGN.md, each stage timed into
+    /// Advances the world by `dt` seconds: the pipeline of ARCHITECTURE.md ("The step"), each stage timed into
     /// [`World::profile`].
     ///
     /// 1. broad phase — candidate pairs (never static–static, sleeping–sleeping or

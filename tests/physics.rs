@@ -1,6 +1,6 @@
 //! Physical cases with closed-form answers, through the whole pipeline (bodies → collision
 //! detection → the resolver → integration), each at 60 Hz and at 240 Hz and each with both
-//! resolvers, Millington and soft step (DESIGN.md, "Validation").
+//! resolvers, Millington and soft step (ARCHITECTURE.md; benches/RESULTS.md, "The analytic set").
 
 mod common;
 use common::*;

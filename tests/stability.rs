@@ -1,4 +1,4 @@
-//! Stability scenes (issue 6, DESIGN.md "Validation"): stacks, pyramids and mass ratios that
+//! Stability scenes (issue 6): stacks, pyramids and mass ratios that
 //! must stand still, and a free spinning box that must flip without losing energy. Each scene
 //! is a file in `assets/` (soft-step resolver, sleeping disabled, so standing still is the
 //! solver's doing and not the sleep system's) and runs here through the whole pipeline.
@@ -20,7 +20,7 @@
 use jostle::scene::Scene;
 use jostle::{BodyHandle, ResolverChoice, Vec3, World};
 
-/// The criterion of DESIGN.md: no box moves more than 1 cm between 2 s and the end.
+/// The stability criterion: no box moves more than 1 cm between 2 s and the end.
 const MAX_DRIFT: f32 = 0.01;
 
 fn scene(file: &str) -> Scene {

@@ -14,7 +14,7 @@ pub enum MassError {
     Inertia(Vec3),
 }
 
-/// Sleep bookkeeping of a body (DESIGN.md, "Sleep and islands").
+/// Sleep bookkeeping of a body (the `jostle-sleep` crate).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SleepState {

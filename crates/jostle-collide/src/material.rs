@@ -31,7 +31,7 @@ impl Material {
         }
     }
 
-    /// The material of a contact between `a` and `b` (DESIGN.md, "Conventions"):
+    /// The material of a contact between `a` and `b` (ARCHITECTURE.md, "Conventions"):
     ///
     /// - friction = sqrt(μa·μb), the geometric mean: a frictionless surface (μ = 0) makes the
     ///   contact frictionless whatever the other is, and equal materials keep their μ;

@@ -244,7 +244,7 @@ fn ball_on_a_half_space_has_one_point_under_its_centre() {
 
 #[test]
 fn box_on_box_gives_a_four_point_manifold() {
-    // One point per pair is why Millington's original cannot stack (DESIGN.md).
+    // One point per pair is why Millington's original cannot stack.
     let mut scene = Scene::new();
     let lower = scene.fixed(&unit_cube(), Vec3::ZERO);
     let upper = scene

@@ -6,7 +6,7 @@
 //! tensors, world-space inverse inertia and the quaternion update of the seed lecture.
 //! It depends on glam alone: no parry, no body storage, no physics state.
 //!
-//! Conventions (DESIGN.md): f32, SI units, right-handed, +Y up. Quaternions as glam stores them
+//! Conventions (ARCHITECTURE.md, "Conventions"): f32, SI units, right-handed, +Y up. Quaternions as glam stores them
 //! (x, y, z, w).
 #![deny(missing_docs)]
 

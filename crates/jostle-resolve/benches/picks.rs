@@ -1,5 +1,5 @@
 //! One full Millington resolver step on synthetic contact sets of growing size, heap pick
-//! against Cyclone's linear-scan pick (DESIGN.md, "Make it scale").
+//! against Cyclone's linear-scan pick (benches/RESULTS.md, "Resolver picks").
 //!
 //! Before the criterion groups run, tables are printed to stderr, one per scene family and
 //! pick strategy: contacts, islands, the largest island, picks per step (position +

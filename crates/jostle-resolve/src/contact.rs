@@ -1,4 +1,4 @@
-//! One contact point between two solver bodies, in DESIGN.md's convention.
+//! One contact point between two solver bodies, in the conventions of the `jostle` crate's ARCHITECTURE.md.
 
 use jostle_math::Vec3;
 

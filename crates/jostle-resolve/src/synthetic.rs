@@ -1,5 +1,5 @@
 //! Synthetic contact sets for benchmarking and testing resolvers without collision detection
-//! (DESIGN.md, "a solver researcher benchmarks the resolver alone").
+//! (so that a solver researcher benchmarks the resolver alone).
 //!
 //! Two families, both deterministic functions of their arguments (a tiny built-in PRNG, no
 //! dependency): **stacks** (columns of unit boxes resting on the static ground, four contacts

@@ -1,5 +1,5 @@
 //! Regression tests for the defects of Cyclone's contact resolution that jostle fixes
-//! (DESIGN.md, "Known defects of the original code"). Each test first shows that Cyclone's
+//! (the known defects of the original code). Each test first shows that Cyclone's
 //! formula, evaluated on the same data, misbehaves, then that the resolver does not.
 //! (The contact-basis defect is tested in jostle-math.)
 

@@ -1,4 +1,4 @@
-//! Resting contact through the whole resolver step (micro-collisions, DESIGN.md): a box on
+//! Resting contact through the whole resolver step (micro-collisions): a box on
 //! static ground with four corner contacts stays put under gravity, and with friction holds on a
 //! slope iff tan θ < μ. Contacts are recomputed from the box pose each step by a tiny
 //! corner-against-plane helper ([`box_plane_contacts`]); no collision layer is involved.

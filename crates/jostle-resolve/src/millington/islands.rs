@@ -4,7 +4,7 @@
 //! (or any immovable body) is never moved, so it connects nothing: a union-find over the
 //! moving bodies splits the contacts into independent islands, solved one after the other
 //! with their own pick budgets. The adjacency lists, per moving body, the contacts that touch
-//! it, so a pick re-keys only those (DESIGN.md, "Make it scale").
+//! it, so a pick re-keys only those.
 //!
 //! Everything is rebuilt each step into reused buffers; order is deterministic: islands are
 //! ordered by their lowest contact index, and contacts within an island and within an

@@ -1,6 +1,6 @@
 //! The Millington resolver: the seed lecture's contact resolution (Millington, *Game Physics
 //! Engine Development*, ch. 14–16), faithful to Cyclone where Cyclone is right and fixed where it
-//! is wrong (DESIGN.md, "Resolver 1: Millington").
+//! is wrong.
 //!
 //! One step is a linear pipeline:
 //! 0. integrate gravity into velocities ([`crate::integrate::integrate_velocities`]);

@@ -1,5 +1,5 @@
 //! The position and velocity passes as [`Pass`] implementations: what "worst" means for each,
-//! how a contact is resolved, and how a neighbour is updated (DESIGN.md, "Resolver 1").
+//! how a contact is resolved, and how a neighbour is updated.
 
 use super::change::BodyChange;
 use super::position::{resolvable, resolve_penetration, update_penetration};

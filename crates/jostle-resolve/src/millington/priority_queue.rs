@@ -2,7 +2,7 @@
 //! key that can be raised or lowered in O(log n) because the heap keeps every item's position.
 //!
 //! This is what turns Cyclone's O(n) "find the worst contact" rescan into an O(log n) pick
-//! (DESIGN.md, "Make it scale"). The order is total and stable: a larger key wins, and on equal
+//! (benches/RESULTS.md, "Resolver picks"). The order is total and stable: a larger key wins, and on equal
 //! keys the **lower id** wins, which is exactly the choice a front-to-back linear scan with a
 //! strict `>` makes; that is what lets [`super::PickStrategy::Heap`] and
 //! [`super::PickStrategy::LinearScan`] give bit-identical results. NaN keys are stored as −∞, so

@@ -318,7 +318,7 @@ pub fn normal_key(p: &PreparedContact) -> f32 {
 }
 
 /// The impulse the velocity pass applies at `p` (contact space, on A): frictionless when
-/// μ ≤ 0 (no friction work at all, DESIGN.md "skip what a scene does not need"), else
+/// μ ≤ 0 (no friction work at all: skip what a scene does not need), else
 /// [`friction_impulse`] (against the impulse `p` accumulated so far this step).
 pub fn contact_impulse(p: &PreparedContact, bodies: &[SolverBody]) -> Vec3 {
     if p.friction > 0.0 {

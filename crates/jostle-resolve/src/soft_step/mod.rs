@@ -1,6 +1,5 @@
 //! The soft-step resolver: substepped sequential impulses with soft contacts, relax and
-//! restitution (Catto, "Solver2D", 2024; the solver of Box2D v3), in 3D (DESIGN.md,
-//! "Resolver 2: soft step").
+//! restitution (Catto, "Solver2D", 2024; the solver of Box2D v3), in 3D.
 //!
 //! One step of length dt with n substeps of h = dt/n is a linear pipeline:
 //! 1. [`prepare`](prepare::prepare_point) every contact once on the step-start poses:
