@@ -346,3 +346,11 @@ fn a_rotation_of_any_finite_length_is_normalised_without_overflow() {
         body.orientation
     );
 }
+
+#[test]
+fn duplicate_body_names_are_refused() {
+    let (body, field) = body_field(
+        "Scene(bodies: [Body(name: \"a\", shape: Ball(radius: 1.0)), Body(name: \"a\", shape: Ball(radius: 1.0), position: (3.0, 0.0, 0.0))])",
+    );
+    assert_eq!((body.as_str(), field.as_str()), ("a", "name"));
+}

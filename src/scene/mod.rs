@@ -37,7 +37,7 @@ pub use error::SceneError;
 pub use generators::Generator;
 pub use perturb::Perturb;
 
-use crate::body_desc::{BodyDesc, MassSpec};
+use crate::body_desc::{BodyDesc, BodyError, MassSpec};
 use crate::settings::{ResolverChoice, WorldSettings};
 use crate::world::World;
 use jostle_collide::{Material, ShapeDesc};
@@ -343,6 +343,8 @@ impl Scene {
                 error: e,
             })?;
         }
+        let names: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
+        unique_names(&names)?;
         for (i, g) in self.generators.iter().enumerate() {
             g.validate().map_err(|(field, message)| {
                 setting(&format!("generators[{i}].{field}"), message)
@@ -405,6 +407,8 @@ impl Scene {
         if let Some(p) = &self.perturb {
             p.apply(&mut out[first_generated..]);
         }
+        let names: Vec<&str> = out.iter().map(|d| d.name.as_str()).collect();
+        unique_names(&names)?;
         Ok(out)
     }
 
@@ -424,4 +428,25 @@ impl Scene {
     pub fn build(&self) -> Result<World, SceneError> {
         self.build_with(self.settings())
     }
+}
+
+/// Refuses two bodies of one name: names are how errors, traces and snapshots tell bodies
+/// apart, and a repeated one would make each of those ambiguous.
+fn unique_names(names: &[&str]) -> Result<(), SceneError> {
+    let mut seen = std::collections::HashMap::with_capacity(names.len());
+    for (i, &name) in names.iter().enumerate() {
+        if let Some(first) = seen.insert(name, i) {
+            return Err(SceneError::Body {
+                file: String::new(),
+                error: BodyError::Field {
+                    body: name.to_string(),
+                    field: "name".into(),
+                    message: format!(
+                        "body {i} has the same name as body {first}; names must be unique"
+                    ),
+                },
+            });
+        }
+    }
+    Ok(())
 }

@@ -6,6 +6,7 @@
 //! drawn with plotters; text uses the DejaVu Sans bytes of the `dejavu` crate through plotters'
 //! ab_glyph renderer, so it works headless with no system fonts.
 
+use crate::staged::Staged;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use jostle::ResolverChoice;
@@ -184,8 +185,10 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("{}: cannot create: {e}", args.out.display()))?;
     let csv_path = args.out.join("results.csv");
-    std::fs::write(&csv_path, csv(&rows))
+    let staged = Staged::new(&csv_path);
+    std::fs::write(staged.path(), csv(&rows))
         .map_err(|e| format!("{}: cannot write: {e}", csv_path.display()))?;
+    staged.commit()?;
     let mut written = vec![csv_path];
     let mut names: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
     names.dedup();
@@ -331,9 +334,10 @@ fn plot_scene(out: &Path, name: &str, rows: &[&Row]) -> Result<Vec<PathBuf>, Str
     let base = out.join(slug(name));
     let svg = base.with_extension("svg");
     let png = base.with_extension("png");
+    let (svg_staged, png_staged) = (Staged::new(&svg), Staged::new(&png));
     const SIZE: (u32, u32) = (800, 560);
     draw(
-        SVGBackend::new(&svg, SIZE).into_drawing_area(),
+        SVGBackend::new(svg_staged.path(), SIZE).into_drawing_area(),
         name,
         rows,
         plotted,
@@ -345,8 +349,16 @@ fn plot_scene(out: &Path, name: &str, rows: &[&Row]) -> Result<Vec<PathBuf>, Str
         rows,
         plotted,
     )?;
-    image::save_buffer(&png, &buf, SIZE.0, SIZE.1, image::ExtendedColorType::Rgb8)
-        .map_err(|e| format!("{}: cannot write: {e}", png.display()))?;
+    image::save_buffer(
+        png_staged.path(),
+        &buf,
+        SIZE.0,
+        SIZE.1,
+        image::ExtendedColorType::Rgb8,
+    )
+    .map_err(|e| format!("{}: cannot write: {e}", png.display()))?;
+    svg_staged.commit()?;
+    png_staged.commit()?;
     Ok(vec![svg, png])
 }
 

@@ -8,6 +8,7 @@
 mod bench_cmd;
 mod render_out;
 mod run_cmd;
+mod staged;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

@@ -4,6 +4,7 @@
 //! the states after steps 0, K, 2K, … (K = `--frame-every`). Everything the user typed is
 //! checked before the run starts, so a bad flag never costs a simulation.
 
+use crate::staged::Staged;
 use jostle::World;
 use jostle_render::{Camera, GifWriter, RenderSettings, Renderer};
 use std::fs::File;
@@ -70,6 +71,8 @@ struct Gif {
 pub struct RenderJob {
     renderer: Renderer,
     path: PathBuf,
+    /// Where the output is written until it is complete.
+    staged: Staged,
     gif: Option<Gif>,
 }
 
@@ -88,6 +91,7 @@ pub fn start(
         contacts: flags.contacts,
     };
     let renderer = Renderer::new(settings).map_err(|e| format!("--render: {e}"))?;
+    let staged = Staged::new(&flags.path);
     let gif = match format {
         Format::Png => None,
         Format::Gif => {
@@ -97,7 +101,7 @@ pub fn start(
             let every = flags
                 .frame_every
                 .unwrap_or_else(|| real_time_every(flags.fps, dt));
-            let file = File::create(&flags.path)
+            let file = File::create(staged.path())
                 .map_err(|e| format!("{}: cannot create: {e}", flags.path.display()))?;
             let writer = GifWriter::new(BufWriter::new(file), flags.fps)
                 .map_err(|e| format!("--fps: {e}"))?;
@@ -107,6 +111,7 @@ pub fn start(
     Ok(RenderJob {
         renderer,
         path: flags.path.clone(),
+        staged,
         gif,
     })
 }
@@ -125,8 +130,9 @@ impl RenderJob {
         Ok(())
     }
 
-    /// Writes the PNG of the final world, or ends the GIF; returns what was written.
-    pub fn finish(mut self, world: &World) -> Result<String, String> {
+    /// Writes the PNG of the final world, or ends the GIF, into the staged file; returns it,
+    /// to be committed with the run's other outputs, and what was written.
+    pub fn finish(mut self, world: &World) -> Result<(Staged, String), String> {
         let (w, h) = (
             self.renderer.settings().width,
             self.renderer.settings().height,
@@ -134,20 +140,25 @@ impl RenderJob {
         match self.gif {
             Some(Gif { writer, every }) => {
                 let frames = writer.frames();
-                writer
+                let out = writer
                     .finish()
                     .map_err(|e| format!("{}: {e}", self.path.display()))?;
-                Ok(format!(
+                // Flushed here, where a failure is reported (a drop would ignore it).
+                out.into_inner()
+                    .map_err(|e| format!("{}: {e}", self.path.display()))?;
+                let message = format!(
                     "wrote {} ({frames} frames of {w}x{h}, every {every} steps)",
                     self.path.display()
-                ))
+                );
+                Ok((self.staged, message))
             }
             None => {
                 let image = self.renderer.render(world);
                 image
-                    .save_with_format(&self.path, jostle_render::image::ImageFormat::Png)
+                    .save_with_format(self.staged.path(), jostle_render::image::ImageFormat::Png)
                     .map_err(|e| format!("{}: {e}", self.path.display()))?;
-                Ok(format!("wrote {} ({w}x{h})", self.path.display()))
+                let message = format!("wrote {} ({w}x{h})", self.path.display());
+                Ok((self.staged, message))
             }
         }
     }

@@ -2,6 +2,7 @@
 //! the run to an image or an animation (`--render`, see `render_out`).
 
 use crate::render_out::{self, RenderFlags};
+use crate::staged::Staged;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use jostle::ResolverChoice;
@@ -88,8 +89,11 @@ pub fn run(args: RunArgs) -> Result<(), String> {
         camera,
     } = load(&args.scene, &overrides).map_err(|e| e.to_string())?;
     let dt = args.dt.unwrap_or(scene_dt);
-    if !(dt.is_finite() && dt > 0.0) {
-        return Err(format!("--dt must be finite and > 0, got {dt}"));
+    if !(dt.is_finite() && dt > 0.0 && dt <= jostle::MAX_DT) {
+        return Err(format!(
+            "--dt must be in (0, {}] s, got {dt}",
+            jostle::MAX_DT
+        ));
     }
     if args.every == 0 {
         return Err("--every must be at least 1".into());
@@ -124,13 +128,14 @@ pub fn run(args: RunArgs) -> Result<(), String> {
 
     let mut trace = match &args.trace {
         Some(path) => {
-            let file = File::create(path)
+            let staged = Staged::new(path);
+            let file = File::create(staged.path())
                 .map_err(|e| format!("{}: cannot create: {e}", path.display()))?;
             let mut w = BufWriter::new(file);
             writeln!(w, "{TRACE_HEADER}")
                 .and_then(|_| write_trace_rows(&mut w, &world))
                 .map_err(|e| e.to_string())?;
-            Some(w)
+            Some((w, staged))
         }
         None => None,
     };
@@ -154,23 +159,43 @@ pub fn run(args: RunArgs) -> Result<(), String> {
             job.observe(w, step).map_err(std::io::Error::other)?;
         }
         match trace.as_mut() {
-            Some(out) if step % every == 0 || step == last_step => write_trace_rows(out, w),
+            Some((out, _)) if step % every == 0 || step == last_step => write_trace_rows(out, w),
             _ => Ok(()),
         }
     })
     .map_err(|e| e.to_string())?;
     bar.finish_and_clear();
-    if let Some(mut w) = trace {
-        w.flush().map_err(|e| e.to_string())?;
+    // Every output is complete before any replaces its target.
+    let trace = match trace {
+        Some((w, staged)) => {
+            w.into_inner()
+                .map_err(|e| e.to_string())
+                .and_then(|f| f.sync_all().map_err(|e| e.to_string()))?;
+            Some(staged)
+        }
+        None => None,
+    };
+    let render = match render {
+        Some(job) => Some(job.finish(&world)?),
+        None => None,
+    };
+    let snapshot = match &args.snapshot {
+        Some(path) => {
+            let staged = Staged::new(path);
+            world
+                .snapshot(&scene_name, dt)
+                .save(staged.path())
+                .map_err(|e| e.to_string())?;
+            Some(staged)
+        }
+        None => None,
+    };
+    for staged in [trace, snapshot].into_iter().flatten() {
+        staged.commit()?;
     }
-    if let Some(job) = render {
-        eprintln!("{}", job.finish(&world)?);
-    }
-    if let Some(path) = &args.snapshot {
-        world
-            .snapshot(&scene_name, dt)
-            .save(path)
-            .map_err(|e| e.to_string())?;
+    if let Some((staged, message)) = render {
+        staged.commit()?;
+        eprintln!("{message}");
     }
     for (step, name) in &summary.quarantined {
         eprintln!("warning: step {step}: body \"{name}\" went non-finite and was frozen");

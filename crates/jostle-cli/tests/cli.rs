@@ -483,3 +483,50 @@ fn outputs_never_overwrite_the_scene_each_other_or_an_untouched_file() {
     assert!(std::fs::read_to_string(&csv).unwrap().lines().count() > 1);
     assert_eq!(std::fs::read_to_string(&scene).unwrap(), text);
 }
+
+/// Outputs are written beside their targets and renamed into place when complete: after a
+/// run nothing partial is left, and each output is whole.
+#[test]
+fn outputs_are_renamed_into_place_whole() {
+    let dir = temp("staged");
+    std::fs::create_dir_all(&dir).unwrap();
+    let (trace, gif, snap) = (dir.join("t.csv"), dir.join("a.gif"), dir.join("s.ron"));
+    std::fs::write(&trace, "old").unwrap();
+    let out = jostle()
+        .args([
+            "run",
+            asset("box_drop.ron").to_str().unwrap(),
+            "--steps",
+            "20",
+        ])
+        .args([
+            "--trace",
+            trace.to_str().unwrap(),
+            "--render",
+            gif.to_str().unwrap(),
+        ])
+        .args(["--size", "32x24", "--snapshot", snap.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows = std::fs::read_to_string(&trace).unwrap().lines().count();
+    assert!(rows > 20, "{rows} trace lines");
+    assert!(std::fs::read(&gif).unwrap().starts_with(b"GIF89a"));
+    assert!(
+        std::fs::read_to_string(&snap)
+            .unwrap()
+            .contains("Snapshot(")
+    );
+    let names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        names.iter().all(|n| !n.contains("jostle-partial")),
+        "left behind: {names:?}"
+    );
+}
