@@ -10,11 +10,12 @@
 //!    manifolds to a batch of independent bodies ([`batch`]) and every kernel below works on
 //!    eight manifolds at once ([`lanes`]). Small islands where a heavy body rests on light
 //!    ones are picked out and their springs sized by their load ([`direct`]).
-//! 2. per substep: integrate gravity (and the implicit gyroscopic torque) into velocities;
+//! 2. per substep: integrate gravity into velocities;
 //!    warm start (apply the accumulated impulses); solve every contact once with its soft bias,
 //!    the separation recomputed from the bodies' motion since the start of the step, the
 //!    push-out of deep or unloaded overlap going to pseudo velocities; integrate velocities
-//!    (and the pseudo velocities, which are then cleared) into position and rotation deltas;
+//!    (and the pseudo velocities, which are then cleared) into position and rotation deltas,
+//!    each body's angular momentum carried through its turn ([`gyroscopic`]);
 //!    relax (solve again without bias). Friction is solved in the relax pass only, unless
 //!    [`SoftStepSettings::friction_in_bias_pass`] is set. After each pass the islands of
 //!    [`direct`] are solved exactly ([`direct::DirectIslands::correct`]), where Gauss-Seidel
@@ -524,18 +525,8 @@ impl Substeps<'_> {
                 ..self.pass
             };
             timing.time(Timing::INTEGRATE, || {
-                self.each_body_range(crew, |states, first| {
-                    if self.gyroscopic {
-                        let inertia = &self.inertia[first..first + states.len()];
-                        integrate::integrate_velocities_gyroscopic(
-                            states,
-                            inertia,
-                            self.gravity,
-                            self.h,
-                        );
-                    } else {
-                        integrate::integrate_velocities(states, self.gravity, self.h);
-                    }
+                self.each_body_range(crew, |states, _| {
+                    integrate::integrate_velocities(states, self.gravity, self.h);
                 });
             });
             timing.time(Timing::SOLVE, || {
@@ -551,7 +542,10 @@ impl Substeps<'_> {
                 self.each_body_range(crew, |states, first| {
                     // SAFETY: the body ranges of a stage are disjoint (as for `states`).
                     let pseudo = unsafe { slice_mut(self.pseudo, first..first + states.len()) };
-                    integrate::integrate_positions(states, pseudo, self.h);
+                    let inertia = self
+                        .gyroscopic
+                        .then(|| &self.inertia[first..first + states.len()]);
+                    integrate::integrate_positions(states, pseudo, inertia, self.h);
                 });
             });
             timing.time(Timing::RELAX, || {

@@ -68,8 +68,8 @@ pub struct SoftStepSettings {
     /// [`SoftStepSettings::RESTITUTION_TOLERANCE`]; it runs only in steps where some contact
     /// bounces, so scenes without restitution never pay for it.
     pub restitution_iterations: u32,
-    /// Apply the implicit gyroscopic torque in each substep's angular integration. Default
-    /// true. Without it a free body's angular momentum is not conserved when its inertia is
+    /// The gyroscopic term: each substep's turn keeps the body's world angular momentum
+    /// (`soft_step::gyroscopic::turn`). Default true. Without it a free body's angular momentum is not conserved when its inertia is
     /// not spherical (a spun box never flips about its intermediate axis).
     pub gyroscopic: bool,
     /// Solve friction in the biased pass too, not only in the relax pass. Default false: the
