@@ -47,7 +47,36 @@ const MIDPOINT_ITERATIONS: usize = 2;
 /// box flipping about its intermediate axis at 10 rad/s within 10 s; the midpoint keeps it
 /// to 6·10⁻⁵ (unit test). `None` when the inertia cannot be inverted.
 pub fn turn(inertia: Mat3, before: Quat, omega: Vec3, h: f32) -> Option<(Quat, Vec3)> {
-    let momentum = rotate_inertia(inertia, before) * omega;
+    turn_against(inertia, Mat3::ZERO, before, omega, h)
+}
+
+/// [`turn`] for a body whose contact rows this step respond through the step-start world
+/// inverse inertia `rows_inverse` (zero: the body has no contact rows, and this is [`turn`]).
+///
+/// The rows change ω by `rows_inverse`·J for an impulse J, and the turn then takes
+/// L = I(before)·ω: the momentum the body gains is I(before)·`rows_inverse`·J, which is J only
+/// while the body's inertia has not turned away from its step-start value. A body turning far
+/// within a step (a needle at 50 m/s spun up by its impact with a floor: its long axis
+/// swings 1 rad within a substep) has I(before)·`rows_inverse` far from the identity, up to
+/// the ratio of its principal moments (2,500 for the needle), and carrying L through its
+/// turns multiplied every impulse of its contacts: the needle reached 10⁷ rad/s
+/// (benches/RESULTS.md, "CCD: no freeze, no tunnel"). So when I·`rows_inverse` at either end
+/// of the turn is off the identity by more than [`ROWS_MISMATCH`] in any entry, this
+/// returns `None` and the caller turns the body by ω alone, as the rows assume (no
+/// gyroscopic term for that substep). A body that turns about an axis of symmetry of its
+/// inertia (a spinning top) keeps I and so the term.
+pub fn turn_against(
+    inertia: Mat3,
+    rows_inverse: Mat3,
+    before: Quat,
+    omega: Vec3,
+    h: f32,
+) -> Option<(Quat, Vec3)> {
+    let inertia_before = rotate_inertia(inertia, before);
+    if rows_inverse != Mat3::ZERO && mismatch(inertia_before, rows_inverse) > ROWS_MISMATCH {
+        return None;
+    }
+    let momentum = inertia_before * omega;
     let omega_at = |q: Quat| {
         let w = rotate_inertia(inertia, q).inverse() * momentum;
         w.is_finite().then_some(w)
@@ -66,8 +95,31 @@ pub fn turn(inertia: Mat3, before: Quat, omega: Vec3, h: f32) -> Option<(Quat, V
         q = integrate_orientation(q, mid * piece);
         w = omega_at(q)?;
     }
+    if rows_inverse != Mat3::ZERO
+        && mismatch(rotate_inertia(inertia, q), rows_inverse) > ROWS_MISMATCH
+    {
+        return None;
+    }
     Some((q, w))
 }
+
+/// The largest entry of I·`rows_inverse` − 1: how far an impulse's momentum through the
+/// contact rows' inverse inertia is from the momentum the body's inertia `inertia` gives it.
+pub fn mismatch(inertia: Mat3, rows_inverse: Mat3) -> f32 {
+    let d = inertia * rows_inverse - Mat3::IDENTITY;
+    d.x_axis
+        .abs()
+        .max(d.y_axis.abs())
+        .max(d.z_axis.abs())
+        .max_element()
+}
+
+/// Largest [`mismatch`] at which [`turn_against`] still carries the momentum of a body with
+/// contact rows. On a sweep of 360 soft-step shots onto floors (benches/RESULTS.md, "CCD: no
+/// freeze, no tunnel"; measured before CCD sampled its stops) 0.05 and 0.2 left 6 shots
+/// frozen for some steps, 0.5 left 9, 2 left 12; the larger of the two keeps the term for
+/// more of the bodies that tumble in contact.
+pub const ROWS_MISMATCH: f32 = 0.2;
 
 /// The largest turn (rad) of one midpoint step of [`turn`]. At 2 rad per step (1000 rad/s at
 /// 480 substeps per second) a free box flipping about its intermediate axis gained 33% of its
@@ -76,8 +128,11 @@ pub fn turn(inertia: Mat3, before: Quat, omega: Vec3, h: f32) -> Option<(Quat, V
 /// gained 0.4%).
 const MAX_PIECE_ANGLE: f32 = 0.1;
 
-/// The most pieces [`turn`] splits a substep into.
-const MAX_PIECES: f32 = 64.0;
+/// The most pieces [`turn`] splits a substep into: pieces of 0.1 rad up to 24,000 rad/s at
+/// 480 substeps per second. At 64, a needle bounced to 1.7·10⁴ rad/s turned in pieces of
+/// 0.55 rad, where the midpoint's fixed point does not converge for its anisotropy, and its
+/// energy in free flight swung by ±20%; at 512 it keeps its start.
+const MAX_PIECES: f32 = 512.0;
 
 #[cfg(test)]
 mod tests {
@@ -133,6 +188,34 @@ mod tests {
         // The energy is not held below its start as the old step's guard held it: at 2 rad
         // per substep it rises at most 0.04% (3.9·10⁻⁴ measured) while it falls up to 13%.
         assert!(gain < 1e-3, "energy rose by {gain} at 1000 rad/s");
+    }
+
+    /// A needle (1 × 0.02 × 0.02 m, 1 kg) with contact rows at its step-start inertia: a
+    /// turn about its long axis, which leaves its inertia as it was, carries the momentum;
+    /// one that swings the long axis away does not (the caller turns it by ω alone).
+    #[test]
+    fn a_body_turned_away_from_its_contact_rows_is_not_carried() {
+        let inertia = Mat3::from_diagonal(Vec3::new(6.67e-5, 0.0834, 0.0834));
+        let rows = inertia.inverse();
+        let h = 1.0 / 480.0;
+        let about_axis = turn_against(inertia, rows, Quat::IDENTITY, Vec3::new(500.0, 0.0, 0.0), h);
+        assert!(about_axis.is_some());
+        let swing = turn_against(inertia, rows, Quat::IDENTITY, Vec3::new(0.0, 0.0, 300.0), h);
+        assert!(swing.is_none());
+        // Without rows (a free body) the same swing is carried.
+        assert!(
+            turn_against(
+                inertia,
+                Mat3::ZERO,
+                Quat::IDENTITY,
+                Vec3::new(0.0, 0.0, 300.0),
+                h
+            )
+            .is_some()
+        );
+        // Already turned far before the substep: not carried either.
+        let turned = Quat::from_rotation_z(0.5);
+        assert!(turn_against(inertia, rows, turned, Vec3::new(1.0, 0.0, 0.0), h).is_none());
     }
 
     #[test]

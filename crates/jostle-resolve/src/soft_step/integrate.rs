@@ -7,7 +7,7 @@
 //! static entry, which is never touched), so that threads can integrate runs of their own.
 
 use super::body_state::{BodyState, PseudoRow};
-use super::gyroscopic::turn;
+use super::gyroscopic::turn_against;
 use jostle_math::{Mat3, Quat, Vec3, integrate_orientation};
 
 /// v ← v + g·h for every body of `states` with mass; no angular change.
@@ -36,28 +36,31 @@ pub const GYROSCOPIC_CUTOFF: f32 = 1e-5;
 /// Left in world space, ω would meet an inertia tensor turned under it (a box spinning at
 /// 10 rad/s pushed out of the floor gained 2.8% of its energy that way).
 ///
-/// With `inertia` (each body's world inertia at the start of the step; zero for a body
-/// without one) this is also where the gyroscopic term acts ([`turn`]): a body that turns by
-/// at least [`GYROSCOPIC_CUTOFF`] keeps its world angular momentum L = I·ω through the turn,
-/// its ω recomputed from L at the new orientation.
+/// With `gyro` (each body's world inertia at the start of the step, zero for a body without
+/// one; and the step-start world inverse inertia its contact rows use, zero for a body
+/// without contact rows) this is also where the gyroscopic term acts
+/// ([`turn_against`](super::gyroscopic::turn_against)): a body that turns by at least
+/// [`GYROSCOPIC_CUTOFF`] keeps its world angular momentum L = I·ω through the turn, its ω
+/// recomputed from L at the new orientation, unless its inertia has turned too far from the
+/// one its contact rows use.
 pub fn integrate_positions(
     states: &mut [BodyState],
     pseudo: &mut [PseudoRow],
-    inertia: Option<&[Mat3]>,
+    gyro: Option<(&[Mat3], &[Mat3])>,
     h: f32,
 ) {
     debug_assert_eq!(states.len(), pseudo.len());
-    debug_assert!(inertia.is_none_or(|i| i.len() == states.len()));
+    debug_assert!(gyro.is_none_or(|(i, r)| i.len() == states.len() && r.len() == states.len()));
     for (k, (s, p)) in states.iter_mut().zip(pseudo.iter_mut()).enumerate() {
         let linear = Vec3::new(p[0], p[1], p[2]);
         let angular = Vec3::new(p[4], p[5], p[6]);
         *p = [0.0; 8];
         s.delta_position += (s.linear_velocity + linear) * h;
         if s.rotates() {
-            let i0 = inertia.map_or(Mat3::ZERO, |i| i[k]);
+            let (i0, rows) = gyro.map_or((Mat3::ZERO, Mat3::ZERO), |(i, r)| (i[k], r[k]));
             let turn_sq = s.angular_velocity.length_squared() * (h * h);
             let carried = (i0 != Mat3::ZERO && turn_sq >= GYROSCOPIC_CUTOFF * GYROSCOPIC_CUTOFF)
-                .then(|| turn(i0, s.delta_rotation, s.angular_velocity, h))
+                .then(|| turn_against(i0, rows, s.delta_rotation, s.angular_velocity, h))
                 .flatten();
             let moved = match carried {
                 Some((after, omega)) => {

@@ -150,6 +150,12 @@ pub struct SoftStepResolver {
     pub settings: SoftStepSettings,
     states: Vec<BodyState>,
     inertia: Vec<Mat3>,
+    /// With the gyroscopic term: each body's step-start world inverse inertia if some contact
+    /// of the step involves it, else zero (`gyroscopic::turn_against`).
+    rows_inverse: Vec<Mat3>,
+    /// With the gyroscopic term: whether some contact of the step joins the body to a body
+    /// that can move.
+    touches_moving: Vec<bool>,
     /// The prepared contacts packed eight manifolds to a batch for the kernels.
     batches: Batches,
     /// Normal impulses before the restitution pass, restored after it.
@@ -273,6 +279,79 @@ impl SoftStepResolver {
             }));
             if let Some(i) = self.inertia.get_mut(STATIC_BODY as usize) {
                 *i = Mat3::ZERO;
+            }
+        }
+    }
+
+    /// Marks the bodies that have contact rows this step (`rows_inverse`), for the gyroscopic
+    /// term, and which of them touch a body that can move (`touches_moving`).
+    fn mark_contact_rows(&mut self, bodies: &[SolverBody], contacts: &[Contact]) {
+        self.rows_inverse.clear();
+        self.touches_moving.clear();
+        if !self.settings.gyroscopic {
+            return;
+        }
+        self.rows_inverse.resize(bodies.len(), Mat3::ZERO);
+        self.touches_moving.resize(bodies.len(), false);
+        let moves = |k: u32| bodies.get(k as usize).is_some_and(|b| b.inv_mass > 0.0);
+        for c in contacts {
+            let both = moves(c.a) && moves(c.b);
+            for k in [c.a, c.b] {
+                if k != STATIC_BODY
+                    && let (Some(r), Some(b)) = (
+                        self.rows_inverse.get_mut(k as usize),
+                        bodies.get(k as usize),
+                    )
+                {
+                    *r = b.inv_inertia;
+                    self.touches_moving[k as usize] |= both;
+                }
+            }
+        }
+    }
+
+    /// The energy bound of a body that turned away from its contact rows: a body whose
+    /// inertia has turned within the step so far from the step-start inertia its contact rows
+    /// use that its turns fell back to ω alone (`gyroscopic::turn_against`), and that touches
+    /// only bodies that cannot move, ends the step with no more mechanical energy than it
+    /// began with, K_end ≤ K_start + m·g·Δx, measured with its inertia at each end; where it
+    /// would have more, its velocities are scaled down to meet the bound.
+    ///
+    /// Why: neither the rows nor the turn are right for such a body. The rows respond
+    /// through an inertia the body no longer has, and ω kept through a turn of the inertia
+    /// does not keep the energy ½·ωᵀ·I·ω: a needle spun by its impact on a floor at 50 m/s,
+    /// its long axis swinging 7 rad within the step, left the step with 36% more energy than
+    /// it came with (benches/RESULTS.md, "CCD: no freeze, no tunnel"). Contacts with what
+    /// cannot move can only take energy (e ≤ 1), so the bound is exact physics, and a body
+    /// that turns with its inertia (a top about its axis) or slowly never meets it.
+    fn bound_turned_energy(&mut self, bodies: &[SolverBody], gravity: jostle_math::Vec3) {
+        for (i, rows) in self.rows_inverse.iter().enumerate() {
+            if *rows == Mat3::ZERO || self.touches_moving[i] {
+                continue;
+            }
+            let (Some(start), Some(state), Some(&inertia)) =
+                (bodies.get(i), self.states.get_mut(i), self.inertia.get(i))
+            else {
+                continue;
+            };
+            if !(start.inv_mass > 0.0) || inertia == Mat3::ZERO {
+                continue;
+            }
+            let inertia_now = gyroscopic::rotate_inertia(inertia, state.delta_rotation);
+            if gyroscopic::mismatch(inertia_now, *rows) <= gyroscopic::ROWS_MISMATCH {
+                continue;
+            }
+            let mass = 1.0 / start.inv_mass;
+            let energy = |v: jostle_math::Vec3, w: jostle_math::Vec3, i: Mat3| {
+                0.5 * mass * v.length_squared() + 0.5 * w.dot(i * w)
+            };
+            let allowed = energy(start.linear_velocity, start.angular_velocity, inertia)
+                + mass * gravity.dot(state.delta_position);
+            let now = energy(state.linear_velocity, state.angular_velocity, inertia_now);
+            if now > allowed {
+                let scale = (allowed.max(0.0) / now).sqrt();
+                state.linear_velocity *= scale;
+                state.angular_velocity *= scale;
             }
         }
     }
@@ -498,6 +577,8 @@ struct Substeps<'a> {
     states: &'a [Shared<BodyState>],
     pseudo: &'a [Shared<PseudoRow>],
     inertia: &'a [Mat3],
+    /// [`SoftStepResolver::rows_inverse`].
+    rows_inverse: &'a [Mat3],
     gyroscopic: bool,
     direct: &'a Shared<direct::DirectIslands>,
     direct_live: bool,
@@ -542,10 +623,14 @@ impl Substeps<'_> {
                 self.each_body_range(crew, |states, first| {
                     // SAFETY: the body ranges of a stage are disjoint (as for `states`).
                     let pseudo = unsafe { slice_mut(self.pseudo, first..first + states.len()) };
-                    let inertia = self
-                        .gyroscopic
-                        .then(|| &self.inertia[first..first + states.len()]);
-                    integrate::integrate_positions(states, pseudo, inertia, self.h);
+                    let range = first..first + states.len();
+                    let gyro = self.gyroscopic.then(|| {
+                        (
+                            &self.inertia[range.clone()],
+                            &self.rows_inverse[range.clone()],
+                        )
+                    });
+                    integrate::integrate_positions(states, pseudo, gyro, self.h);
                 });
             });
             timing.time(Timing::RELAX, || {
@@ -660,6 +745,7 @@ impl Resolver for SoftStepResolver {
         let start = Instant::now();
         self.load_bodies(bodies);
         let any_restitution = self.prepare_contacts(bodies, contacts, h, ctx.gravity.length());
+        self.mark_contact_rows(bodies, contacts);
         // Rigid contacts have their own push-out and no spring to size: no direct solve.
         let direct_rows = if self.settings.rigid_contacts {
             0
@@ -735,6 +821,7 @@ impl Resolver for SoftStepResolver {
                 states: share(&mut self.states),
                 pseudo: share(&mut self.pseudo),
                 inertia: &self.inertia,
+                rows_inverse: &self.rows_inverse,
                 gyroscopic: self.settings.gyroscopic,
                 direct: share_one(&mut self.direct),
                 direct_live,
@@ -837,6 +924,9 @@ impl Resolver for SoftStepResolver {
             for (p, &saved) in self.batches.points.iter_mut().zip(&self.saved_impulse) {
                 p.normal_impulse = saved;
             }
+        }
+        if self.settings.gyroscopic {
+            self.bound_turned_energy(bodies, ctx.gravity);
         }
         relax_time += t.elapsed();
 
