@@ -5,9 +5,10 @@ use crate::StepReport;
 use crate::profile::StepProfile;
 use jostle_body::{BodySet, CcdMode, apply_forces};
 use jostle_collide::{
-    BodyContact, BroadPhase, CcdSettings, CcdShape, ColliderHandle, ColliderSet, NarrowPhase, Pose,
+    BodyContact, BroadPhase, CcdSettings, CcdShape, ColliderHandle, ColliderSet, Material,
+    NarrowPhase, Pose,
 };
-use jostle_math::Vec3;
+use jostle_math::{Mat3, Vec3, skew, world_inverse_inertia};
 use jostle_resolve::{Contact, STATIC_BODY, SolverBody};
 use jostle_sleep::{IslandSet, SleepSettings, update_motion};
 
@@ -29,8 +30,31 @@ pub(crate) struct Scratch {
     pub body_slot: Vec<u32>,
     /// CCD: candidate colliders of one sweep.
     pub ccd_candidates: Vec<ColliderHandle>,
-    /// CCD: (solver index, fraction of the motion to keep) of every body stopped this step.
-    pub ccd_stops: Vec<(u32, f32)>,
+    /// CCD: every body stopped this step, by its solver index.
+    pub ccd_stops: Vec<CcdStop>,
+    /// CCD: (body slot, collider hit) of every stop of the previous step, sorted.
+    pub ccd_previous: Vec<(u32, ColliderHandle)>,
+}
+
+/// A body CCD stops: where, and on what.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CcdStop {
+    /// The body's solver index.
+    solver: u32,
+    /// Fraction of the step's motion kept.
+    fraction: f32,
+    /// The body's collider that hit.
+    collider: ColliderHandle,
+    /// The resting collider it hit.
+    target: ColliderHandle,
+    /// The body's pose at the stop.
+    stop: Pose,
+    /// The body's pose at the impact.
+    impact: Pose,
+    /// The contact the cast found at the impact.
+    contact: Option<jostle_collide::ccd::CcdContact>,
+    /// The centre of mass reached the surface ([`jostle_collide::CcdHit::core`]).
+    core: bool,
 }
 
 /// Wakes every sleeping island touched by an awake body. Contacts with fixed bodies never
@@ -183,6 +207,7 @@ pub(crate) fn ccd(
             shape,
             Pose::from_parts(body.position, body.orientation),
             Pose::from_parts(end.position, end.orientation),
+            end.angular_velocity * dt,
             colliders,
             bodies,
             broad,
@@ -190,23 +215,33 @@ pub(crate) fn ccd(
             &mut scratch.ccd_candidates,
         );
         if let Some(hit) = hit {
-            scratch.ccd_stops.push((solver, hit.fraction));
+            scratch.ccd_stops.push(CcdStop {
+                solver,
+                fraction: hit.fraction,
+                collider: handle,
+                target: hit.collider,
+                stop: hit.stop,
+                impact: hit.impact,
+                contact: hit.contact,
+                core: hit.core,
+            });
         }
     }
     // A body with several colliders stops at the earliest of their hits.
     scratch
         .ccd_stops
-        .sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    scratch.ccd_stops.dedup_by_key(|s| s.0);
+        .sort_unstable_by(|a, b| (a.solver.cmp(&b.solver)).then(a.fraction.total_cmp(&b.fraction)));
+    scratch.ccd_stops.dedup_by_key(|s| s.solver);
     p.ccd_hits = scratch.ccd_stops.len();
-    for &(solver, t) in &scratch.ccd_stops {
+    for stop in &scratch.ccd_stops {
+        let (solver, t) = (stop.solver, stop.fraction);
         let slot = scratch.body_slot[solver as usize];
         let Some((_, start)) = bodies.by_index(slot) else {
             continue;
         };
         let end = &mut scratch.bodies[solver as usize];
         let end_position = end.position;
-        end.position = start.position.lerp(end.position, t);
+        end.position = stop.stop.translation;
         end.linear_velocity = rewound_velocity(
             end.linear_velocity,
             end.last_acceleration,
@@ -216,9 +251,118 @@ pub(crate) fn ccd(
         // Turned back with the body, the angular velocity keeps its body-frame value, so the
         // rotational energy ½ωᵀIω is unchanged; kept in world frame it would meet a different
         // world inertia and change the energy (found by tests/properties.rs).
-        let orientation = start.orientation.slerp(end.orientation, t).normalize();
+        let orientation = stop.stop.rotation;
         end.angular_velocity = (orientation * end.orientation.inverse()) * end.angular_velocity;
         end.orientation = orientation;
+
+        // The impact itself, resolved here against what the body hit (issue 16): kept
+        // approaching, a body whose resolver could not stop it (a needle spun up by its first
+        // bounce, whose far end then swings through a thin floor) was stopped at the same pose
+        // step after step while the resolver's impulses at that pose pumped its spin.
+        let (Some(collider), Some(target)) =
+            (colliders.get(stop.collider), colliders.get(stop.target))
+        else {
+            continue;
+        };
+        let repeated = (scratch.ccd_previous)
+            .binary_search(&(slot, stop.target))
+            .is_ok();
+        // Only a body stopped on the same collider in the step before: after a first stop the
+        // next step's contacts resolve the impact, all its points together and with the
+        // resolver's restitution; resolving every first stop here as well measured worse
+        // (soft step, the CCD sweep of benches/RESULTS.md: 10 of 360 shots frozen against 6).
+        // A sleeping target is left to the next step's contact, which wakes it and shares the
+        // impact.
+        // A body whose centre reached the surface is half into it already: resolved at once.
+        if !(repeated || stop.core) || !bodies.get(target.body).is_some_and(|b| b.is_fixed()) {
+            continue;
+        }
+        // At the impact pose, where the point that hits is found; the impulse is applied there
+        // (the velocities are those of the stop, the same but for the backed-off turn).
+        let at = stop.impact;
+        let reach = CCD_CONTACT_REACH * settings.slop;
+        let contact = stop
+            .contact
+            .or_else(|| jostle_collide::ccd::stop_contact(collider, at, target, bodies, reach));
+        if let Some(c) = contact {
+            let turn = at.rotation * end.orientation.inverse();
+            let w = turn * end.angular_velocity;
+            let inv_inertia = world_inverse_inertia(at.rotation, start.inv_inertia_body());
+            let (v, w) = impact_velocity(
+                (end.linear_velocity, w),
+                end.inv_mass,
+                inv_inertia,
+                c.point - at.translation,
+                c.normal,
+                c.material,
+            );
+            end.linear_velocity = v;
+            end.angular_velocity = turn.inverse() * w;
+        }
+    }
+    scratch.ccd_previous.clear();
+    for stop in &scratch.ccd_stops {
+        let slot = scratch.body_slot[stop.solver as usize];
+        scratch.ccd_previous.push((slot, stop.target));
+    }
+    scratch.ccd_previous.sort_unstable();
+}
+
+/// How far from what it hit (in CCD slops) a stopped body's contact is looked for: it stops
+/// one slop short, or deeper when its core was cast from an overlapping start.
+const CCD_CONTACT_REACH: f32 = 4.0;
+
+/// The velocity `(v, ω)` of a body of inverse mass `inv_mass` and world inverse inertia
+/// `inv_inertia` after an impact at the lever arm `r` (from its centre of mass) on a fixed
+/// surface of normal `n` (toward the body), with the contact's `material`, as the seed
+/// lecture's contact-space impulse: unchanged unless the point approaches; then the impulse
+/// that leaves the point moving at −e·vₙ along n with no sliding, if it lies in the friction
+/// cone; else dynamic friction, an impulse along n − μ·t̂ (t̂ the sliding direction) that
+/// gives the same normal velocity; else (a lever arm that would turn that impulse into a
+/// push along the surface) a frictionless one along n. Each is used only if it does not add
+/// kinetic energy (ΔE = j·v_p + ½·jᵀ·K·j for the impulse j and the point velocity v_p), which
+/// the frictionless one never does for e ≤ 1.
+fn impact_velocity(
+    (v, w): (Vec3, Vec3),
+    inv_mass: f32,
+    inv_inertia: Mat3,
+    r: Vec3,
+    n: Vec3,
+    material: Material,
+) -> (Vec3, Vec3) {
+    let vp = v + w.cross(r);
+    let vn = vp.dot(n);
+    if vn.is_nan() || vn >= 0.0 {
+        return (v, w);
+    }
+    let e = material.restitution.clamp(0.0, 1.0);
+    let rx = skew(r);
+    // K = m⁻¹·1 − [r]×·I⁻¹·[r]×: the point's velocity change per unit impulse.
+    let k = Mat3::IDENTITY * inv_mass - rx * inv_inertia * rx;
+    let adds_energy = |j: Vec3| j.dot(vp) + 0.5 * j.dot(k * j) > 0.0;
+    let apply = |j: Vec3| (v + j * inv_mass, w + inv_inertia * r.cross(j));
+    let usable = |j: Vec3| j.is_finite() && j.dot(n) >= 0.0 && !adds_energy(j);
+
+    let target = n * (-e * vn);
+    let stick = k.inverse() * (target - vp);
+    let jn = stick.dot(n);
+    if usable(stick) && (stick - n * jn).length() <= material.friction * jn {
+        return apply(stick);
+    }
+    let slide = vp - n * vn;
+    if slide.length_squared() > 0.0 {
+        let direction = n - slide.normalize() * material.friction;
+        let lambda = -(1.0 + e) * vn / n.dot(k * direction);
+        let j = direction * lambda;
+        if lambda > 0.0 && usable(j) {
+            return apply(j);
+        }
+    }
+    let lambda = -(1.0 + e) * vn / n.dot(k * n);
+    if lambda.is_finite() && lambda > 0.0 {
+        apply(n * lambda)
+    } else {
+        (v, w)
     }
 }
 

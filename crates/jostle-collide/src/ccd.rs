@@ -10,7 +10,11 @@
 //! collision"): the facade moves the body back to that fraction of its motion and keeps its
 //! velocity, so the next step's narrow phase finds a speculative contact and the resolver
 //! resolves the impact. The rest of the step's motion of that one body is dropped (Box2D v3
-//! does the same); nothing is lost that a contact would not have removed anyway.
+//! does the same); nothing is lost that a contact would not have removed anyway. A body
+//! stopped on the same collider two steps running (its resolver could not stop it: a needle
+//! whose far end swings through a thin floor) has its velocity resolved against the hit at
+//! the time of impact as well ([`CcdHit::contact`], [`stop_contact`]), so it is not rewound
+//! again for the same approach.
 //!
 //! How: a linear shape cast ([`cast_shapes`]) of the start pose along the step's translation,
 //! stopping `slop` short; a nonlinear cast ([`cast_shapes_nonlinear`]: the start pose turning
@@ -23,18 +27,23 @@
 //! the start and still approaching (a cast hit at time 0) is not stopped outright, which would
 //! freeze a fast body sliding along a floor: instead a small core sphere at its centre of mass
 //! is cast, and only a core that would reach the surface (the body crossing it) stops the body.
+//! The same core cast runs when the cast of the whole shape finds nothing: the centre of mass
+//! crossing a surface is a crossing whatever parry's nonlinear cast concluded for a body
+//! turning tens of radians within the step.
 //! Moving–moving pairs are not swept: their narrow phase and resolver handle them.
 
 use crate::broad_phase::BroadPhase;
 use crate::collider::{Collider, ColliderHandle, ColliderSet};
+use crate::material::Material;
 use crate::settings::CcdSettings;
 use jostle_body::BodySet;
-use jostle_math::Vec3;
+use jostle_math::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
+use parry3d::query::Ray;
 use parry3d::query::{
     NonlinearRigidMotion, ShapeCastHit, ShapeCastOptions, ShapeCastStatus, Unsupported,
-    cast_shapes, cast_shapes_nonlinear, distance,
+    cast_shapes, cast_shapes_nonlinear, contact, distance,
 };
 use parry3d::shape::Ball;
 
@@ -91,6 +100,64 @@ pub struct CcdHit {
     pub fraction: f32,
     /// The resting collider hit.
     pub collider: ColliderHandle,
+    /// The body's centre-of-mass pose at `fraction` of the swept motion (the translation
+    /// interpolated, the turn at a constant rate, whole turns included: see `spin` of
+    /// [`sweep`]).
+    pub stop: Pose,
+    /// The body's pose at the time of impact itself (the same as `stop` unless the stop was
+    /// backed off from a turning cast's touching pose): where [`stop_contact`] finds the
+    /// point that hits.
+    pub impact: Pose,
+    /// Where the cast touched at `impact`, when the cast says (not for a body that started
+    /// within `slop` of the surface): the point that hits, which need not be the point
+    /// nearest the surface at the stop.
+    pub contact: Option<CcdContact>,
+    /// Whether the stop is the centre of mass reaching the surface (the cast of a core at
+    /// the centre), not the shape touching it: the body is then half into what it hit, and
+    /// `contact` is at its centre.
+    pub core: bool,
+}
+
+/// The contact between a collider stopped by CCD and the collider it hit, at the stop pose.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CcdContact {
+    /// Point on the stopped collider's surface, world frame (m).
+    pub point: Vec3,
+    /// Unit normal from the hit collider toward the stopped one, world frame.
+    pub normal: Vec3,
+    /// The pair's material ([`Material::mix`]).
+    pub material: Material,
+}
+
+/// The contact of `collider`, its body at the centre-of-mass pose `body_pose`, with `target`
+/// (a resting collider, at its body's pose in `bodies`), if they are within `reach` (m) of each
+/// other; `None` when farther apart or when parry has no contact query for the pair. CCD uses
+/// it to resolve the velocity of a body it stopped against what it hit.
+pub fn stop_contact(
+    collider: &Collider,
+    body_pose: Pose,
+    target: &Collider,
+    bodies: &BodySet,
+    reach: f32,
+) -> Option<CcdContact> {
+    let target_body = bodies.get(target.body)?;
+    let from = body_pose * collider.local_pose;
+    let to = target.world_pose(target_body);
+    let c = contact(
+        &from,
+        collider.shape.as_ref(),
+        &to,
+        target.shape.as_ref(),
+        reach,
+    )
+    .ok()
+    .flatten()?;
+    let normal = -c.normal1;
+    (normal.is_finite() && c.point1.is_finite()).then_some(CcdContact {
+        point: c.point1,
+        normal,
+        material: Material::mix(collider.material, target.material),
+    })
 }
 
 /// Sweeps `collider` from its body's pose `start` to `end` (centre-of-mass poses) against the
@@ -105,6 +172,7 @@ pub fn sweep(
     shape: &CcdShape,
     start: Pose,
     end: Pose,
+    spin: Vec3,
     colliders: &ColliderSet,
     bodies: &BodySet,
     broad: &BroadPhase,
@@ -112,11 +180,7 @@ pub fn sweep(
     candidates: &mut Vec<ColliderHandle>,
 ) -> Option<CcdHit> {
     let delta = end.translation - start.translation;
-    let mut turn = end.rotation * start.rotation.inverse();
-    if turn.w < 0.0 {
-        turn = -turn;
-    }
-    let rotation = turn.to_scaled_axis();
+    let rotation = unwrapped_turn(end.rotation * start.rotation.inverse(), spin);
     let angle = rotation.length();
     let from = start * collider.local_pose;
     // The linear cast ignores the rotation, so its time of impact is off by as much as the
@@ -150,9 +214,41 @@ pub fn sweep(
             continue;
         }
         let to = target.world_pose(target_body);
-        let hit = if turning {
+        let mut impact_time = None;
+        let mut touch = None;
+        let mut core_normal = None;
+        let touching = turning
+            && distance(&from, collider.shape.as_ref(), &to, target.shape.as_ref())
+                .is_ok_and(|d| d.distance <= settings.slop);
+        let hit = if touching {
+            // Already touching: parry's nonlinear cast, which then steps forward looking for
+            // an approach, returned 10⁻⁶ for a plate pivoting about a corner that was
+            // separating, and the plate was put back at the start of the step, step after
+            // step (benches/RESULTS.md, "CCD: no freeze, no tunnel"). Sampled instead.
+            let depth = (SAMPLED_DEPTH * shape.thickness).max(settings.slop);
+            let step = (settings.motion_fraction * shape.thickness).max(settings.slop);
+            let (hit, at) = sample_turning(
+                collider,
+                &from,
+                delta,
+                rotation,
+                shape.motion(delta.length(), angle) / step,
+                target,
+                &to,
+                depth,
+            );
+            if let Some(Impact::At(_)) = hit {
+                impact_time = at.map(|a| a.0);
+                touch = at.map(|a| (a.1, a.2));
+            }
+            hit
+        } else if turning {
             match cast_turning(collider, &from, delta, rotation, target, &to) {
-                Ok(hit) => {
+                Ok((hit, at)) => {
+                    if let Some(Impact::At(t)) = hit {
+                        impact_time = Some(t);
+                        touch = at;
+                    }
                     hit.map(|t| back_off(t, shape.motion(delta.length(), angle), settings.slop))
                 }
                 // parry has no nonlinear cast for this pair (half-spaces, composite against
@@ -172,22 +268,104 @@ pub fn sweep(
                 }
             }
         } else {
-            cast_linear(collider, &from, delta, target, &to, settings.slop)
+            let (hit, at) = cast_linear(collider, &from, delta, target, &to, settings.slop);
+            if let Some(Impact::At(_)) = hit {
+                touch = at;
+            }
+            hit
         };
         let fraction = match hit {
             Some(Impact::At(t)) => t,
-            Some(Impact::AtStart) => match cast_core(shape, start, delta, target, &to) {
-                Some(t) => t,
+            // The centre of mass, which no rotation moves, crossing the surface: whatever
+            // the cast of the whole shape says, the body went through (a needle spun at
+            // 1,450 rad/s by its impact, 24 rad within the step, fell through a 20 cm floor
+            // past parry's nonlinear cast, which found nothing).
+            Some(Impact::AtStart) | None => match cast_core(shape, start, delta, target, &to) {
+                Some((t, normal)) => {
+                    core_normal = Some(normal);
+                    t
+                }
                 None => continue,
             },
-            None => continue,
         };
         let closer = best.is_none_or(|b| (fraction, handle) < (b.fraction, b.collider));
         if closer {
+            let at = |t: f32| {
+                Pose::from_parts(
+                    start.translation + delta * t,
+                    (Quat::from_scaled_axis(rotation * t) * start.rotation).normalize(),
+                )
+            };
+            let stop = at(fraction);
+            let (impact, contact) = match core_normal {
+                // The centre reached the surface: the impact is the body's as a whole, at its
+                // centre along the surface normal, without friction.
+                Some(normal) => (
+                    stop,
+                    Some(CcdContact {
+                        point: stop.translation,
+                        normal,
+                        material: Material {
+                            friction: 0.0,
+                            ..Material::mix(collider.material, target.material)
+                        },
+                    }),
+                ),
+                None => {
+                    let impact = at(impact_time.unwrap_or(fraction));
+                    let contact = touch.map(|(point, normal)| {
+                        let pose = impact * collider.local_pose;
+                        CcdContact {
+                            point: pose * point,
+                            normal: -(pose.rotation * normal),
+                            material: Material::mix(collider.material, target.material),
+                        }
+                    });
+                    (impact, contact)
+                }
+            };
             best = Some(CcdHit {
                 fraction,
                 collider: handle,
+                stop,
+                impact,
+                contact,
+                core: core_normal.is_some(),
             });
+        }
+    }
+    best
+}
+
+/// Most whole turns [`unwrapped_turn`] considers.
+const MAX_TURNS: u32 = 64;
+
+/// The rotation vector of the turn `turn` (start to end) that the body made, told apart from
+/// the others with the same end (θ + 2πk about its axis, 2π − θ + 2πk about the opposite one)
+/// as the one nearest to `spin`, the rotation vector ω·dt of its angular velocity. The
+/// shortest one alone (θ ≤ π) is a body spinning at 5.5 rad per step cast as turning 0.8 rad
+/// the other way: a needle spun up by a bounce was cast back into the floor it had just left,
+/// stopped there step after step.
+fn unwrapped_turn(turn: Quat, spin: Vec3) -> Vec3 {
+    use std::f32::consts::TAU;
+    let turn = if turn.w < 0.0 { -turn } else { turn };
+    let shortest = turn.to_scaled_axis();
+    let angle = shortest.length();
+    let axis = if angle > 0.0 {
+        shortest / angle
+    } else if spin.length_squared() > 0.0 {
+        spin.normalize()
+    } else {
+        return shortest;
+    };
+    let mut best = shortest;
+    let turns = ((spin.length() / TAU) as u32 + 1).min(MAX_TURNS);
+    for k in 0..=turns {
+        let whole = TAU * k as f32;
+        for candidate in [axis * (angle + whole), -axis * (TAU - angle + whole)] {
+            if candidate.distance_squared(spin) < best.distance_squared(spin) {
+                best = candidate;
+            }
         }
     }
     best
@@ -219,7 +397,7 @@ fn cast_linear(
     target: &Collider,
     to: &Pose,
     slop: f32,
-) -> Option<Impact> {
+) -> (Option<Impact>, Option<Witness>) {
     let options = ShapeCastOptions {
         max_time_of_impact: 1.0,
         target_distance: slop,
@@ -234,8 +412,25 @@ fn cast_linear(
         Vec3::ZERO,
         target.shape.as_ref(),
         options,
-    );
-    impact(hit.ok().flatten())
+    )
+    .ok()
+    .flatten();
+    (impact(hit), witness(hit))
+}
+
+/// Where a cast touches: the point and the collider's outward normal there, both in the
+/// collider's frame.
+type Witness = (Vec3, Vec3);
+
+/// The point (in the collider's frame) and the collider's outward normal (same frame) where
+/// a cast touches, unless it touched at the start (then parry does not compute them).
+fn witness(hit: Option<ShapeCastHit>) -> Option<Witness> {
+    let hit = hit?;
+    let ok = hit.status != ShapeCastStatus::PenetratingOrWithinTargetDist
+        && hit.witness1.is_finite()
+        && hit.normal1.is_finite()
+        && hit.normal1.length_squared() > 0.5;
+    ok.then_some((hit.witness1, hit.normal1))
 }
 
 /// Nonlinear cast: the collider at `from` translating by `delta` while turning by the rotation
@@ -247,7 +442,7 @@ fn cast_turning(
     rotation: Vec3,
     target: &Collider,
     to: &Pose,
-) -> Result<Option<Impact>, Unsupported> {
+) -> Result<(Option<Impact>, Option<Witness>), Unsupported> {
     // The centre of mass in the collider's frame: the origin of the body frame.
     let centre = collider.local_pose.inverse().translation;
     let moving = NonlinearRigidMotion::new(*from, centre, delta, rotation);
@@ -261,11 +456,83 @@ fn cast_turning(
         1.0,
         false,
     )?;
-    Ok(impact(hit))
+    Ok((impact(hit), witness(hit)))
 }
 
 /// Most distance queries of one conservative advancement.
 const MAX_ADVANCE_ITERATIONS: usize = 64;
+
+/// Overlap (in the moving body's thicknesses, at least the slop) that [`sample_turning`]
+/// lets a body reach before it stops it: what the next step's contacts push out.
+const SAMPLED_DEPTH: f32 = 0.25;
+
+/// Most samples of [`sample_turning`].
+const MAX_SAMPLES: f32 = 256.0;
+
+/// Bisections of [`sample_turning`] between its last shallow sample and its first deep one.
+const SAMPLE_BISECTIONS: usize = 8;
+
+/// The motion of [`cast_turning`] for a body that touches `target` at its start: sampled at
+/// `samples` times (rounded up; between 1 and [`MAX_SAMPLES`]) for the first at which the body
+/// overlaps `target` by more than `depth`, then bisected between it and the sample before.
+/// Returns the last time found within `depth` (the stop), and, at the deep time, that time,
+/// the deepest point of the collider and its outward normal there (both in the collider's
+/// frame): the point that hits. `None` when no sample is that deep.
+#[allow(clippy::too_many_arguments)]
+fn sample_turning(
+    collider: &Collider,
+    from: &Pose,
+    delta: Vec3,
+    rotation: Vec3,
+    samples: f32,
+    target: &Collider,
+    to: &Pose,
+    depth: f32,
+) -> (Option<Impact>, Option<(f32, Vec3, Vec3)>) {
+    let centre = collider.local_pose.inverse().translation;
+    let moving = NonlinearRigidMotion::new(*from, centre, delta, rotation);
+    let deep = |t: f32| {
+        let pose = moving.position_at_time(t);
+        contact(
+            &pose,
+            collider.shape.as_ref(),
+            to,
+            target.shape.as_ref(),
+            0.0,
+        )
+        .ok()
+        .flatten()
+        .filter(|c| c.dist < -depth)
+        .map(|c| (pose, c))
+    };
+    let n = samples.ceil().clamp(1.0, MAX_SAMPLES) as u32;
+    let mut shallow = 0.0;
+    for k in 1..=n {
+        let t = k as f32 / n as f32;
+        let Some(mut hit) = deep(t).map(|h| (t, h)) else {
+            shallow = t;
+            continue;
+        };
+        for _ in 0..SAMPLE_BISECTIONS {
+            let mid = 0.5 * (shallow + hit.0);
+            match deep(mid) {
+                Some(h) => hit = (mid, h),
+                None => shallow = mid,
+            }
+        }
+        let (t, (pose, c)) = hit;
+        let point = pose.inverse() * c.point1;
+        let normal = pose.rotation.inverse() * c.normal1;
+        let ok = point.is_finite() && normal.is_finite();
+        let stop = if shallow > 0.0 {
+            Impact::At(shallow)
+        } else {
+            Impact::AtStart
+        };
+        return (Some(stop), ok.then_some((t, point, normal)));
+    }
+    (None, None)
+}
 
 /// Conservative advancement (Mirtich 1996): the same motion as [`cast_turning`], for pairs
 /// parry cannot cast nonlinearly. No point of the shape moves faster than `speed` (m per step),
@@ -324,7 +591,7 @@ fn cast_core(
     delta: Vec3,
     target: &Collider,
     to: &Pose,
-) -> Option<f32> {
+) -> Option<(f32, Vec3)> {
     let core = Ball::new(0.25 * shape.thickness);
     let options = ShapeCastOptions {
         max_time_of_impact: 1.0,
@@ -341,10 +608,24 @@ fn cast_core(
         Vec3::ZERO,
         target.shape.as_ref(),
         options,
-    );
-    match impact(hit.ok().flatten())? {
-        Impact::At(t) => Some(t),
-        Impact::AtStart => None,
+    )
+    .ok()
+    .flatten();
+    match impact(hit)? {
+        Impact::At(t) => {
+            let normal = to.rotation * hit?.normal2;
+            normal.is_finite().then_some((t, normal))
+        }
+        // The core already overlaps (the body half into the surface, its centre still
+        // outside): the centre itself, a ray. Without it a plate sunk to its middle in a floor
+        // by an earlier impact crossed it in the next step (benches/RESULTS.md, "CCD: no
+        // freeze, no tunnel").
+        Impact::AtStart => {
+            let ray = Ray::new(start.translation, delta);
+            let hit = target.shape.cast_ray_and_get_normal(to, &ray, 1.0, true)?;
+            (hit.time_of_impact > 0.0 && hit.normal.is_finite())
+                .then_some((hit.time_of_impact, hit.normal))
+        }
     }
 }
 
@@ -385,6 +666,7 @@ mod tests {
             &shape,
             start,
             end,
+            Vec3::ZERO,
             &colliders,
             &bodies,
             &broad,
@@ -402,6 +684,7 @@ mod tests {
             &shape,
             start,
             Pose::from_translation(Vec3::new(3.0, 0.0, 0.0)),
+            Vec3::ZERO,
             &colliders,
             &bodies,
             &broad,
@@ -457,6 +740,7 @@ mod tests {
             &shape,
             start,
             end,
+            Vec3::ZERO,
             &colliders,
             &bodies,
             &broad,

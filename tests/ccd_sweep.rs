@@ -1,0 +1,311 @@
+//! Continuous collision detection over a seeded family of shots (issue 16, item 1): thin
+//! plates, needles, wedges and balls, tilted and spinning, thrown at 10 to 1,000 m/s onto
+//! fixed floors and into fixed walls 1 cm and 20 cm thick, with restitution 0, 0.3 and 1,
+//! with gravity on and off, with both resolvers and sleeping off. Every shot runs 4 s and is
+//! checked at every step for
+//!
+//! - through: its centre beyond the slab's far side, inside the slab's extent;
+//! - frozen: its pose exactly unchanged for two steps running while it moves faster than
+//!   5 cm/s (a body CCD puts back at the same pose step after step). One step at the same pose
+//!   is a stop at the very start of the step (the body was within the CCD slop of the surface)
+//!   whose impact the next step's contacts resolve: counted as a pause, not a freeze;
+//! - energy: its mechanical energy ½mv² + ½ωᵀIω + m·g·y above the start's.
+//!
+//! The CI part asserts that no shot goes through or freezes, for both resolvers, and that no
+//! soft-step shot gains energy. `every_shot_keeps_its_energy_in_both_resolvers` (ignored)
+//! asserts the energy for the Millington resolver too, which does not hold yet: it prints
+//! every shot that fails (benches/RESULTS.md, "CCD: no freeze, no tunnel").
+
+use jostle::{BodyDesc, BodyHandle, Quat, ResolverChoice, ShapeDesc, Vec3, World, WorldSettings};
+
+const DT: f32 = 1.0 / 60.0;
+const STEPS: usize = 240;
+/// Shots per resolver in the CI part.
+const SHOTS: u64 = 48;
+
+/// SplitMix64: a small seeded generator, so every run sees the same shots.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [lo, hi).
+    fn uniform(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * ((self.next() >> 40) as f32 / (1u64 << 24) as f32)
+    }
+
+    fn pick<T: Copy>(&mut self, items: &[T]) -> T {
+        items[(self.next() % items.len() as u64) as usize]
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Projectile {
+    /// 1 × 0.04 × 1 m.
+    Plate,
+    /// 1 × 0.02 × 0.02 m.
+    Needle,
+    /// Radius 0.05 m.
+    Ball,
+    /// A triangular prism 0.6 m long, 0.1 m at its thick end, tapering to an edge; 0.4 m wide.
+    Wedge,
+}
+
+/// What the shot is thrown at.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Target {
+    /// A slab below, its top face at y = 0; the shot falls onto it from 2 m.
+    Floor,
+    /// A slab standing upright, its face at x = 0 facing +x; the shot flies at it from 2 m.
+    Wall,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Shot {
+    projectile: Projectile,
+    target: Target,
+    /// The slab's thickness (m).
+    floor: f32,
+    speed: f32,
+    restitution: f32,
+    gravity: bool,
+    rotation: Quat,
+    direction: Vec3,
+    spin: Vec3,
+}
+
+impl Shot {
+    /// Shot number `index` of the family.
+    fn new(index: u64) -> Self {
+        let mut rng = Rng(0x5EED_CCD0 ^ index.wrapping_mul(0x1000_0001));
+        let projectile = rng.pick(&[
+            Projectile::Plate,
+            Projectile::Plate,
+            Projectile::Needle,
+            Projectile::Needle,
+            Projectile::Ball,
+            Projectile::Wedge,
+        ]);
+        let target = rng.pick(&[Target::Floor, Target::Floor, Target::Wall]);
+        let axis = Vec3::new(
+            rng.uniform(-1.0, 1.0),
+            rng.uniform(-1.0, 1.0),
+            rng.uniform(-1.0, 1.0),
+        )
+        .try_normalize()
+        .unwrap_or(Vec3::X);
+        let rotation = Quat::from_axis_angle(axis, rng.uniform(0.0, std::f32::consts::PI));
+        let (a, b) = (rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5));
+        let direction = match target {
+            Target::Floor => Vec3::new(a, -1.0, b),
+            Target::Wall => Vec3::new(-1.0, a, b),
+        }
+        .normalize();
+        let spin = Vec3::new(
+            rng.uniform(-5.0, 5.0),
+            rng.uniform(-5.0, 5.0),
+            rng.uniform(-5.0, 5.0),
+        );
+        Self {
+            projectile,
+            target,
+            floor: rng.pick(&[0.01, 0.2]),
+            speed: rng.pick(&[10.0, 20.0, 20.0, 50.0, 50.0, 200.0, 1000.0]),
+            restitution: rng.pick(&[0.0, 0.3, 1.0]),
+            gravity: rng.pick(&[true, true, true, false]),
+            rotation,
+            direction,
+            spin,
+        }
+    }
+}
+
+/// What happened to one shot.
+#[derive(Clone, Copy, Debug, Default)]
+struct Outcome {
+    through: bool,
+    /// Steps at the pose of the step before (while moving).
+    paused_steps: u32,
+    /// Most consecutive steps at one pose (while moving), minus one: 0 for pauses.
+    frozen_steps: u32,
+    /// Largest mechanical energy above the start's, relative to the start's.
+    energy_gain: f64,
+}
+
+fn run(resolver: &ResolverChoice, shot: &Shot) -> Outcome {
+    let g = if shot.gravity { -9.81 } else { 0.0 };
+    let mut settings = WorldSettings {
+        gravity: Vec3::new(0.0, g, 0.0),
+        resolver: resolver.clone(),
+        ..Default::default()
+    };
+    settings.sleep.enabled = false;
+    let mut world = World::new(settings);
+    let (half_extents, centre, start) = match shot.target {
+        Target::Floor => (
+            Vec3::new(20.0, 0.5 * shot.floor, 20.0),
+            Vec3::new(0.0, -0.5 * shot.floor, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+        ),
+        Target::Wall => (
+            Vec3::new(0.5 * shot.floor, 20.0, 20.0),
+            Vec3::new(-0.5 * shot.floor, 0.0, 0.0),
+            Vec3::new(2.0, 1.0, 0.0),
+        ),
+    };
+    world
+        .add_body(
+            BodyDesc::fixed("slab", ShapeDesc::Cuboid { half_extents })
+                .at(centre)
+                .with_material(0.5, shot.restitution),
+        )
+        .expect("slab");
+    let shape = match shot.projectile {
+        Projectile::Plate => ShapeDesc::Cuboid {
+            half_extents: Vec3::new(0.5, 0.02, 0.5),
+        },
+        Projectile::Needle => ShapeDesc::Cuboid {
+            half_extents: Vec3::new(0.5, 0.01, 0.01),
+        },
+        Projectile::Ball => ShapeDesc::Ball { radius: 0.05 },
+        Projectile::Wedge => ShapeDesc::ConvexHull {
+            points: [-0.2f32, 0.2]
+                .iter()
+                .flat_map(|&z| {
+                    [
+                        Vec3::new(-0.3, -0.05, z),
+                        Vec3::new(0.3, -0.05, z),
+                        Vec3::new(0.3, 0.05, z),
+                    ]
+                })
+                .collect(),
+        },
+    };
+    let body = world
+        .add_body(
+            BodyDesc::dynamic("shot", shape)
+                .at(start)
+                .rotated(shot.rotation)
+                .moving(shot.direction * shot.speed, shot.spin)
+                .with_mass(1.0)
+                .with_material(0.5, shot.restitution),
+        )
+        .expect("shot");
+    let energy =
+        |world: &World| world.kinetic_energy() - f64::from(g) * position(world, body).y as f64;
+    let start = energy(&world);
+    let mut outcome = Outcome::default();
+    let mut before = pose(&world, body);
+    let mut run_length = 0;
+    for _ in 0..STEPS {
+        let report = world.step(DT).expect("step");
+        assert!(
+            report.quarantined.is_empty(),
+            "{shot:?}: {:?}",
+            report.quarantined
+        );
+        let after = pose(&world, body);
+        let b = world.body(body).expect("shot");
+        if after == before && b.linear_velocity.length() > 0.05 {
+            outcome.paused_steps += 1;
+            run_length += 1;
+            outcome.frozen_steps = outcome.frozen_steps.max(run_length - 1);
+        } else {
+            run_length = 0;
+        }
+        let p = after.0;
+        let beyond = match shot.target {
+            Target::Floor => p.y < -shot.floor && p.x.abs() < 20.0 && p.z.abs() < 20.0,
+            Target::Wall => p.x < -shot.floor && p.y.abs() < 20.0 && p.z.abs() < 20.0,
+        };
+        outcome.through |= beyond;
+        outcome.energy_gain = outcome.energy_gain.max((energy(&world) - start) / start);
+        before = after;
+    }
+    outcome
+}
+
+fn position(world: &World, body: BodyHandle) -> Vec3 {
+    world.body(body).expect("shot").position
+}
+
+fn pose(world: &World, body: BodyHandle) -> (Vec3, Quat) {
+    let b = world.body(body).expect("shot");
+    (b.position, b.orientation)
+}
+
+/// Energy gain (relative) tolerated as f32 rounding over a run.
+const ENERGY_ROUNDING: f64 = 1e-3;
+
+fn resolvers() -> [(&'static str, ResolverChoice); 2] {
+    [
+        ("soft step", ResolverChoice::default()),
+        ("millington", ResolverChoice::Millington(Default::default())),
+    ]
+}
+
+#[test]
+fn no_shot_goes_through_the_floor_or_freezes() {
+    for (name, resolver) in resolvers() {
+        for i in 0..SHOTS {
+            let shot = Shot::new(i);
+            let outcome = run(&resolver, &shot);
+            assert!(!outcome.through, "{name}, shot {i} went through: {shot:?}");
+            assert!(
+                outcome.frozen_steps == 0,
+                "{name}, shot {i} froze: {outcome:?} {shot:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn no_soft_step_shot_gains_energy() {
+    let resolver = ResolverChoice::default();
+    for i in 0..SHOTS {
+        let shot = Shot::new(i);
+        let outcome = run(&resolver, &shot);
+        assert!(
+            outcome.energy_gain <= ENERGY_ROUNDING,
+            "shot {i} gained {:.2}% of its energy: {shot:?}",
+            100.0 * outcome.energy_gain
+        );
+    }
+}
+
+/// The whole of item 1 over 240 shots per resolver; prints every shot that fails.
+#[test]
+#[ignore = "open (issue 16 item 1): the Millington resolver's bounces of thin rotating bodies gain energy at e = 1"]
+fn every_shot_keeps_its_energy_in_both_resolvers() {
+    // `CCD_SHOTS` sets the count (default 240).
+    let shots: u64 = std::env::var("CCD_SHOTS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(240);
+    let mut failures = Vec::new();
+    for (name, resolver) in resolvers() {
+        let (mut through, mut frozen, mut paused, mut gained) = (0, 0, 0, 0);
+        for i in 0..shots {
+            let shot = Shot::new(i);
+            let o = run(&resolver, &shot);
+            through += o.through as u32;
+            frozen += (o.frozen_steps > 0) as u32;
+            paused += (o.paused_steps > 0) as u32;
+            gained += (o.energy_gain > ENERGY_ROUNDING) as u32;
+            if o.through || o.frozen_steps > 0 || o.energy_gain > ENERGY_ROUNDING {
+                eprintln!("{name} shot {i}: {o:?} {shot:?}");
+                failures.push((name, i));
+            }
+        }
+        eprintln!(
+            "{name}: of {shots} shots {through} through, {frozen} frozen, {paused} paused, {gained} gained energy"
+        );
+    }
+    assert!(failures.is_empty(), "{} shots failed", failures.len());
+}
