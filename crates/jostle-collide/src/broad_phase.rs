@@ -150,6 +150,20 @@ impl BroadPhase {
         (p.generation == collider.generation() && !p.unbounded).then_some(p.aabb)
     }
 
+    /// Appends to `out` the colliders of awake bodies that may touch `aabb` (enlarged boxes of
+    /// the last update, as [`BroadPhase::resting_near`] for the resting ones). Continuous
+    /// collision detection sweeps a fast body against those of them that move slowly.
+    pub fn awake_near(&self, aabb: &Aabb, out: &mut Vec<ColliderHandle>) {
+        for j in self.tree.intersect_aabb(aabb) {
+            if let Some(p) = &self.proxies[j as usize]
+                && p.awake
+                && p.aabb.intersects(aabb)
+            {
+                out.push(ColliderHandle::new(j, p.generation));
+            }
+        }
+    }
+
     /// Appends to `out` the colliders of resting bodies (fixed or sleeping: they do not move
     /// during a step) that may touch `aabb`: those whose enlarged box overlaps it and the
     /// half-spaces it reaches. Boxes are those of the last update, the poses resting bodies

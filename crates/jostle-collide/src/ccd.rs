@@ -1,9 +1,10 @@
-//! Continuous collision detection: the earliest time a moving collider touches resting
-//! geometry during a step.
+//! Continuous collision detection: the earliest time a moving collider touches resting or
+//! slow geometry during a step.
 //!
 //! In: a collider, its body's pose at the start of the step (where contacts were detected) and
 //! at its end (where the resolver integrated it), the colliders and bodies, and the broad phase
-//! whose boxes locate resting (fixed or sleeping) colliders. Out: the fraction of the step at
+//! whose boxes locate resting (fixed or sleeping) colliders and slow awake ones (which the
+//! caller names: a bullet is swept into a stack of awake boxes at their start poses). Out: the fraction of the step at
 //! which the collider would first come within [`CcdSettings::slop`] of one of them.
 //!
 //! The seed lecture's velocity-based resolution ("move them back to the point of first
@@ -30,7 +31,8 @@
 //! The same core cast runs when the cast of the whole shape finds nothing: the centre of mass
 //! crossing a surface is a crossing whatever parry's nonlinear cast concluded for a body
 //! turning tens of radians within the step.
-//! Moving–moving pairs are not swept: their narrow phase and resolver handle them.
+//! Two fast bodies are not swept against each other: their narrow phase and resolver handle
+//! them.
 
 use crate::broad_phase::BroadPhase;
 use crate::collider::{Collider, ColliderHandle, ColliderSet};
@@ -161,8 +163,10 @@ pub fn stop_contact(
 }
 
 /// Sweeps `collider` from its body's pose `start` to `end` (centre-of-mass poses) against the
-/// resting colliders near the motion (through `broad`'s boxes) and returns the earliest hit,
-/// ties broken by the lower collider handle. `candidates` is scratch space, cleared here.
+/// resting colliders near the motion (through `broad`'s boxes), and the awake ones for which
+/// `slow` holds (bodies that move too little in the step to matter: they are taken at their
+/// pose at the start of the step), and returns the earliest hit, ties broken by the lower
+/// collider handle. `candidates` is scratch space, cleared here.
 ///
 /// `None` when nothing is touched, or when the body only grazes what it already touched at the
 /// start (see the module docs). Shape pairs parry cannot cast are skipped.
@@ -173,6 +177,7 @@ pub fn sweep(
     start: Pose,
     end: Pose,
     spin: Vec3,
+    slow: impl Fn(ColliderHandle) -> bool,
     colliders: &ColliderSet,
     bodies: &BodySet,
     broad: &BroadPhase,
@@ -202,6 +207,16 @@ pub fn sweep(
 
     candidates.clear();
     broad.resting_near(&swept, candidates);
+    let resting = candidates.len();
+    broad.awake_near(&swept, candidates);
+    let mut k = resting;
+    for i in resting..candidates.len() {
+        if slow(candidates[i]) {
+            candidates[k] = candidates[i];
+            k += 1;
+        }
+    }
+    candidates.truncate(k);
     let mut best: Option<CcdHit> = None;
     for &handle in candidates.iter() {
         let Some(target) = colliders.get(handle) else {
@@ -667,6 +682,7 @@ mod tests {
             start,
             end,
             Vec3::ZERO,
+            |_| false,
             &colliders,
             &bodies,
             &broad,
@@ -685,6 +701,7 @@ mod tests {
             start,
             Pose::from_translation(Vec3::new(3.0, 0.0, 0.0)),
             Vec3::ZERO,
+            |_| false,
             &colliders,
             &bodies,
             &broad,
@@ -741,6 +758,7 @@ mod tests {
             start,
             end,
             Vec3::ZERO,
+            |_| false,
             &colliders,
             &bodies,
             &broad,
