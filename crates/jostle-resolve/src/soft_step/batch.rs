@@ -6,9 +6,14 @@
 //! body keeps a 64-bit mask of the colours its manifolds already use, and a manifold takes the
 //! lowest colour free in both of its bodies' masks. Manifolds of one colour touch disjoint
 //! bodies; they are packed eight to a batch in colour order, then input order, so the result is
-//! deterministic. The static entry (index 0) is never written and never coloured. A manifold
-//! that finds all 64 colours taken (a body with more than 64 manifolds) goes to a batch of its
-//! own, solved after the coloured ones.
+//! deterministic. The static entry (index 0) is never written and never coloured. A body has
+//! room for 64 colours in its mask; the manifolds that find all 64 taken (a body with more
+//! than 64 manifolds) are coloured again in a second round with the next 64 colours and fresh
+//! masks, and so on for up to 16 rounds (1,024 colours). Only a manifold left after those goes
+//! to a batch of its own, solved after the coloured ones. With one round, 200 boxes started
+//! at one point (19,900 manifolds, 199 per box) put most of their manifolds into batches of
+//! one, each a stage of its own, and the soft step's resolve stage took 371 ms a step; with
+//! the rounds 35 ms (benches/RESULTS.md, "Colours beyond 64").
 //!
 //! Solving colour by colour is still Gauss-Seidel (each batch sees the velocities the previous
 //! batches left), only in a different order than the input's.
@@ -29,8 +34,15 @@ pub const LANES: usize = WIDTH;
 /// Most contact points per manifold lane.
 pub const MAX_POINTS: usize = 4;
 
+/// Colours of one round of colouring (one bit each in a body's mask).
+const ROUND_COLOURS: u32 = 64;
+
+/// Rounds of colouring: the manifolds a round could not colour (a body with more than 64
+/// manifolds) are coloured again with the next 64 colours and fresh masks.
+const ROUNDS: u32 = 16;
+
 /// Colours available before a manifold overflows into a batch of its own.
-const COLOURS: u32 = 64;
+const COLOURS: u32 = ROUND_COLOURS * ROUNDS;
 
 /// Marks a lane-point that holds no contact.
 pub const NO_SOURCE: u32 = u32::MAX;
@@ -144,6 +156,7 @@ pub struct Batches {
     pub any_restitution: bool,
     // Scratch reused from step to step.
     colour_mask: Vec<u64>,
+    counts: Vec<u32>,
     runs: Vec<Run>,
     order: Vec<u32>,
     /// Input indices of the contacts that take part, in input order.
@@ -204,7 +217,8 @@ impl Batches {
         }
         self.contacts = self.kept.len() as u32;
 
-        // Manifolds: runs of the same body pair, coloured by the colour masks.
+        // Manifolds: runs of the same body pair, coloured by the colour masks: first all with
+        // colours 0..64, then again those left with colours 64..128 and fresh masks, and so on.
         let mut start = 0;
         let kept = &self.kept;
         while start < kept.len() {
@@ -230,15 +244,13 @@ impl Batches {
             } else {
                 free.trailing_zeros()
             };
-            if colour < COLOURS {
+            if colour < ROUND_COLOURS {
                 for i in [a, b] {
                     if i != STATIC_BODY {
                         self.colour_mask[i as usize] |= 1 << colour;
                     }
                 }
                 self.colours = self.colours.max(colour + 1);
-            } else {
-                self.overflow += 1;
             }
             self.runs.push(Run {
                 start: start as u32,
@@ -248,8 +260,42 @@ impl Batches {
             start += len;
         }
 
+        // The later rounds, over the runs the one before left uncoloured (in input order).
+        for round in 1..ROUNDS {
+            let left = self.runs.iter().filter(|r| r.colour == COLOURS).count();
+            if left == 0 {
+                break;
+            }
+            self.colour_mask.fill(0);
+            let base = round * ROUND_COLOURS;
+            for r in self.runs.iter_mut().filter(|r| r.colour == COLOURS) {
+                let c = &contacts[kept[r.start as usize] as usize];
+                let mask = |i: u32| {
+                    if i == STATIC_BODY {
+                        0
+                    } else {
+                        self.colour_mask[i as usize]
+                    }
+                };
+                let free = !(mask(c.a) | mask(c.b));
+                if free != 0 {
+                    let colour = free.trailing_zeros();
+                    for i in [c.a, c.b] {
+                        if i != STATIC_BODY {
+                            self.colour_mask[i as usize] |= 1 << colour;
+                        }
+                    }
+                    r.colour = base + colour;
+                    self.colours = self.colours.max(base + colour + 1);
+                }
+            }
+        }
+        self.overflow = self.runs.iter().filter(|r| r.colour == COLOURS).count() as u32;
+
         // Colour order, stable: a counting sort of run indices by colour.
-        let mut counts = [0u32; COLOURS as usize + 2];
+        self.counts.clear();
+        self.counts.resize(COLOURS as usize + 2, 0);
+        let counts = &mut self.counts;
         for r in &self.runs {
             counts[r.colour as usize + 1] += 1;
         }
@@ -453,17 +499,66 @@ mod tests {
     }
 
     #[test]
-    fn a_body_with_more_than_64_manifolds_overflows_into_single_batches() {
-        // 70 one-point manifolds all on body 1.
+    fn a_body_with_more_than_64_manifolds_takes_colours_of_later_rounds() {
+        // 70 one-point manifolds all on body 1: 64 colours in the first round, 6 in the
+        // second, one manifold each (they all share body 1).
         let contacts: Vec<Contact> = (2..72)
             .map(|b| Contact::new(1, b, Vec3::ZERO, Vec3::X, 0.0))
             .collect();
         let mut batches = Batches::default();
         batches.pack(&contacts, &bodies(71), 0.02, &params());
-        assert_eq!(batches.colours, 64);
-        assert_eq!(batches.overflow, 6);
+        assert_eq!(batches.colours, 70);
+        assert_eq!(batches.overflow, 0);
         assert_eq!(batches.manifolds.len(), 70);
         assert_eq!(batches.lanes().count(), 70);
+    }
+
+    #[test]
+    fn manifolds_of_a_dense_cluster_share_batches_beyond_64_colours() {
+        // 40 bodies all touching each other (780 one-point manifolds, 39 per body): one round
+        // of 64 colours holds them, eight to a batch where they do not share bodies.
+        let mut contacts = Vec::new();
+        for a in 1..41u32 {
+            for b in a + 1..41 {
+                contacts.push(Contact::new(a, b, Vec3::ZERO, Vec3::X, 0.0));
+            }
+        }
+        let mut batches = Batches::default();
+        batches.pack(&contacts, &bodies(40), 0.02, &params());
+        assert_eq!(batches.overflow, 0);
+        assert!(
+            batches.manifolds.len() < 780 / 4,
+            "{}",
+            batches.manifolds.len()
+        );
+        // 200 bodies: 199 manifolds per body need several rounds; none overflows.
+        let mut contacts = Vec::new();
+        for a in 1..201u32 {
+            for b in a + 1..201 {
+                contacts.push(Contact::new(a, b, Vec3::ZERO, Vec3::X, 0.0));
+            }
+        }
+        batches.pack(&contacts, &bodies(200), 0.02, &params());
+        assert_eq!(batches.overflow, 0);
+        assert!(batches.colours > 64);
+        assert!(
+            batches.manifolds.len() < 19_900 / 4,
+            "{}",
+            batches.manifolds.len()
+        );
+        // The manifolds of one group (one colour) never share a body.
+        for g in batches.groups.windows(2) {
+            let mut seen = std::collections::HashSet::new();
+            for m in &batches.manifolds[g[0] as usize..g[1] as usize] {
+                for lane in 0..LANES {
+                    for body in [m.a[lane], m.b[lane]] {
+                        if body != STATIC_BODY {
+                            assert!(seen.insert(body), "body {body} twice in a group");
+                        }
+                    }
+                }
+            }
+        }
     }
 
     /// The lane-wise preparation gives what the formulas give for one contact: effective
