@@ -227,13 +227,9 @@ pub fn load(path: &std::path::Path, overrides: &Overrides) -> Result<RunSetup, L
     if let Some(on) = overrides.sleep {
         settings.sleep.enabled = on;
     }
-    let world = scene.build_with(settings).map_err(|e| match e {
-        crate::scene::SceneError::Body { error, .. } => crate::scene::SceneError::Body {
-            file: file.clone(),
-            error,
-        },
-        other => other,
-    })?;
+    let world = scene
+        .build_with(settings)
+        .map_err(|e| e.in_file(&file, &text))?;
     Ok(RunSetup {
         world,
         name: scene.name,

@@ -65,6 +65,7 @@ fn body_field(text: &str) -> (String, String) {
         SceneError::Body {
             file,
             error: jostle::BodyError::Field { body, field, .. },
+            ..
         } => {
             assert_eq!(file, "bad.ron");
             (body, field)
@@ -353,4 +354,49 @@ fn duplicate_body_names_are_refused() {
         "Scene(bodies: [Body(name: \"a\", shape: Ball(radius: 1.0)), Body(name: \"a\", shape: Ball(radius: 1.0), position: (3.0, 0.0, 0.0))])",
     );
     assert_eq!((body.as_str(), field.as_str()), ("a", "name"));
+}
+
+#[test]
+fn validation_errors_name_the_line_and_column_of_the_field() {
+    let text = "Scene(name: \"s\",\n  bodies: [\n    Body(name: \"a\", shape: Ball(radius: 0.5)),\n    Body(name: \"b\", shape: Ball(radius: 0.5),\n         mass: -1.0),\n  ])\n";
+    let e = error(text).to_string();
+    assert!(
+        e.starts_with("bad.ron:5:10: body \"b\": field `mass`"),
+        "{e}"
+    );
+    // A repeated name at the body that repeats it.
+    let text = "Scene(name: \"s\", bodies: [\n Body(name: \"a\", shape: Ball(radius: 0.5)),\n Body(name: \"a\", shape: Ball(radius: 0.5))])";
+    let e = error(text).to_string();
+    assert!(
+        e.starts_with("bad.ron:3:7: body \"a\": field `name`"),
+        "{e}"
+    );
+    // A setting of the resolver.
+    let text = "Scene(name: \"s\",\n resolver: SoftStep(\n   substeps: 0),\n bodies: [])";
+    let e = error(text).to_string();
+    assert!(
+        e.starts_with("bad.ron:3:4: field `resolver.substeps`"),
+        "{e}"
+    );
+}
+
+#[test]
+fn two_confusing_parse_errors_carry_a_hint() {
+    let e = error("Scene(name: \"s\", steps: 10.5, bodies: [])").to_string();
+    assert!(e.contains("a whole number is expected"), "{e}");
+    let e = error("Scene(name: \"s\", sleep: Some(SleepSettings(enabled: false)), bodies: [])")
+        .to_string();
+    assert!(e.contains("`sleep: (enabled: false)`"), "{e}");
+}
+
+#[test]
+fn a_shape_too_small_for_f32_names_its_size_field() {
+    let scene = Scene::parse(
+        "Scene(name: \"s\", bodies: [Body(name: \"t\", shape: Ball(radius: 1e-30))])",
+        "bad.ron",
+    )
+    .expect("parses: the mass is computed when the world is built");
+    let e = scene.build().err().expect("refused").to_string();
+    assert!(e.contains("body \"t\": field `shape.radius`"), "{e}");
+    assert!(e.contains("no usable mass"), "{e}");
 }

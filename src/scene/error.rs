@@ -29,18 +29,23 @@ pub enum SceneError {
         body: Option<String>,
     },
     /// A body is invalid.
-    #[error("{file}: {error}")]
+    #[error("{file}{}: {error}", location(at))]
     Body {
         /// The file.
         file: String,
+        /// Line and column (from 1) of the field in the file, or of the body when the field is
+        /// not written there; `None` for scenes not parsed from text or a body not found in it.
+        at: Option<(usize, usize)>,
         /// Which body and field.
         error: BodyError,
     },
     /// A scene-level setting is invalid.
-    #[error("{file}: field `{field}`: {message}")]
+    #[error("{file}{}: field `{field}`: {message}", location(at))]
     Setting {
         /// The file.
         file: String,
+        /// Line and column (from 1) of the field in the file, when it is written there.
+        at: Option<(usize, usize)>,
         /// The field.
         field: String,
         /// What is wrong.
@@ -49,14 +54,30 @@ pub enum SceneError {
 }
 
 impl SceneError {
-    pub(crate) fn in_file(self, name: &str) -> Self {
+    /// The error as found in the file `name` whose text is `text`: the file named, and the
+    /// line and column of the field (or body) when the text shows where it is.
+    pub(crate) fn in_file(self, name: &str, text: &str) -> Self {
         match self {
-            Self::Body { error, .. } => Self::Body {
+            Self::Body { error, at, .. } => {
+                let BodyError::Field {
+                    body,
+                    field,
+                    message,
+                } = &error;
+                // A repeated name is reported at its later occurrence.
+                let last = field == "name" && message.contains("the same name");
+                let at = at.or_else(|| locate_body_field(text, body, field, last));
+                Self::Body {
+                    file: name.into(),
+                    at,
+                    error,
+                }
+            }
+            Self::Setting {
+                field, message, at, ..
+            } => Self::Setting {
                 file: name.into(),
-                error,
-            },
-            Self::Setting { field, message, .. } => Self::Setting {
-                file: name.into(),
+                at: at.or_else(|| locate_setting(text, &field)),
                 field,
                 message,
             },
@@ -66,11 +87,15 @@ impl SceneError {
 
     pub(crate) fn from_ron(file: &str, text: &str, e: ron::error::SpannedError) -> Self {
         let pos = e.span.start;
+        let mut message = e.code.to_string();
+        if let Some(hint) = hint(text, pos.line, pos.col, &message) {
+            message = format!("{message} ({hint})");
+        }
         Self::Parse {
             file: file.into(),
             line: pos.line,
             column: pos.col,
-            message: e.code.to_string(),
+            message,
             body: enclosing_body(text, pos.line, pos.col),
         }
     }
@@ -103,4 +128,133 @@ fn enclosing_body(text: &str, line: usize, column: usize) -> Option<String> {
     let name_at = rest.find("name:")?;
     let after = rest[name_at + 5..].trim_start().strip_prefix('"')?;
     Some(after[..after.find('"')?].to_string())
+}
+
+/// `:line:column` of a location, or nothing.
+fn location(at: &Option<(usize, usize)>) -> String {
+    at.map(|(line, column)| format!(":{line}:{column}"))
+        .unwrap_or_default()
+}
+
+/// Line and column (from 1) of byte `offset` of `text`.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let start = before.rfind('\n').map_or(0, |i| i + 1);
+    (line, before[start..].chars().count() + 1)
+}
+
+/// Byte offset of the first `key:` in `text[from..to]` (the key a whole word, spaces allowed
+/// before the colon), skipping `//` comments.
+fn find_key(text: &str, from: usize, to: usize, key: &str) -> Option<usize> {
+    let region = text.get(from..to.min(text.len()))?;
+    let mut search = 0;
+    while let Some(i) = region[search..].find(key) {
+        let at = search + i;
+        search = at + key.len();
+        let before_ok = region[..at]
+            .chars()
+            .next_back()
+            .is_none_or(|c| !(c.is_alphanumeric() || c == '_'));
+        let after_ok = region[at + key.len()..].trim_start().starts_with(':');
+        let line_start = region[..at].rfind('\n').map_or(0, |n| n + 1);
+        let commented = region[line_start..at].contains("//");
+        if before_ok && after_ok && !commented {
+            return Some(from + at);
+        }
+    }
+    None
+}
+
+/// Where the body named `body` sets `field` (its last dotted part: `shape.radius` is
+/// `radius:`), or where its name is when the field is not written; with `last`, the last body
+/// of that name (a repeated name).
+fn locate_body_field(text: &str, body: &str, field: &str, last: bool) -> Option<(usize, usize)> {
+    let quoted = format!("\"{body}\"");
+    let key = field.rsplit('.').next().unwrap_or(field);
+    // Every body of that name: (where its name is, where it sets the field).
+    let mut found = Vec::new();
+    let mut search = 0;
+    while let Some(at) = find_key(text, search, text.len(), "name") {
+        search = at + 4;
+        let Some(value) = text[search..].trim_start().strip_prefix(':') else {
+            continue;
+        };
+        if !value.trim_start().starts_with(&quoted) {
+            continue;
+        }
+        // The body's parentheses: from the last `Body(` before its name to the matching `)`.
+        let Some(open) = text[..at].rfind("Body(") else {
+            continue;
+        };
+        let start = open + 4;
+        let mut depth = 0i32;
+        let mut end = text.len();
+        for (i, ch) in text[start..].char_indices() {
+            depth += match ch {
+                '(' => 1,
+                ')' => -1,
+                _ => 0,
+            };
+            if depth == 0 {
+                end = start + i;
+                break;
+            }
+        }
+        found.push((at, find_key(text, start, end, key)));
+    }
+    // A repeated name: its later body. Otherwise the first body of that name that writes the
+    // field (two bodies of one name: the error may be the second's), else the first.
+    let (name_at, field_at) = if last {
+        *found.last()?
+    } else {
+        found
+            .iter()
+            .copied()
+            .find(|f| f.1.is_some())
+            .or_else(|| found.first().copied())?
+    };
+    Some(line_column(text, field_at.unwrap_or(name_at)))
+}
+
+/// Where a scene-level `field` is written (`resolver.substeps`: `substeps:` after
+/// `resolver:`; `generators[1].count`: `count:` after `generators:`), if it is.
+fn locate_setting(text: &str, field: &str) -> Option<(usize, usize)> {
+    let mut parts = field.split('.');
+    let first = parts.next()?;
+    let first = first.split('[').next().unwrap_or(first);
+    let mut at = find_key(text, 0, text.len(), first)?;
+    if let Some(last) = parts.next_back() {
+        let last = last.split('[').next().unwrap_or(last);
+        at = find_key(text, at, text.len(), last)?;
+    }
+    Some(line_column(text, at))
+}
+
+/// A hint for two of ron's messages that do not say what is wrong: a fraction where a whole
+/// number is expected (`steps: 10.5` is read as 10 followed by `.5`: "Expected comma"), and
+/// an optional setting written with its type (`sleep: Some(SleepSettings(...))`).
+fn hint(text: &str, line: usize, column: usize, message: &str) -> Option<&'static str> {
+    let offset: usize = text
+        .split_inclusive('\n')
+        .take(line.saturating_sub(1))
+        .map(str::len)
+        .sum::<usize>()
+        + column.saturating_sub(1);
+    let here = text.get(offset.min(text.len())..)?;
+    let before = text.get(..offset.min(text.len()))?;
+    let after_digit = before.trim_end().ends_with(|c: char| c.is_ascii_digit());
+    let fraction = here.trim_start().starts_with('.') || here.trim_start().starts_with(['e', 'E']);
+    if after_digit && fraction {
+        return Some("a whole number is expected here, without a fraction or exponent");
+    }
+    if message.contains("Unexpected field named `SleepSettings`")
+        || message.contains("Unexpected field named `Some`")
+    {
+        return Some(
+            "write the settings' fields in parentheses, without `Some` or the type's name: \
+             `sleep: (enabled: false)`",
+        );
+    }
+    None
 }

@@ -282,7 +282,7 @@ impl Scene {
         let scene: Scene = options
             .from_str(text)
             .map_err(|e| SceneError::from_ron(file, text, e))?;
-        scene.validate().map_err(|e| e.in_file(file))?;
+        scene.validate().map_err(|e| e.in_file(file, text))?;
         Ok(scene)
     }
 
@@ -290,6 +290,7 @@ impl Scene {
     pub fn validate(&self) -> Result<(), SceneError> {
         let setting = |field: &str, message: String| SceneError::Setting {
             file: String::new(),
+            at: None,
             field: field.into(),
             message,
         };
@@ -340,6 +341,7 @@ impl Scene {
         for body in &self.bodies {
             body.to_desc().map_err(|e| SceneError::Body {
                 file: String::new(),
+                at: None,
                 error: e,
             })?;
         }
@@ -397,6 +399,7 @@ impl Scene {
         for b in &self.bodies {
             out.push(b.to_desc().map_err(|e| SceneError::Body {
                 file: String::new(),
+                at: None,
                 error: e,
             })?);
         }
@@ -418,6 +421,7 @@ impl Scene {
         for desc in self.body_descs()? {
             world.add_body(desc).map_err(|e| SceneError::Body {
                 file: String::new(),
+                at: None,
                 error: e,
             })?;
         }
@@ -438,6 +442,7 @@ fn unique_names(names: &[&str]) -> Result<(), SceneError> {
         if let Some(first) = seen.insert(name, i) {
             return Err(SceneError::Body {
                 file: String::new(),
+                at: None,
                 error: BodyError::Field {
                     body: name.to_string(),
                     field: "name".into(),

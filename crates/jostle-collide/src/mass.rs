@@ -82,18 +82,22 @@ pub fn mass_properties(desc: &ShapeDesc, density: f32) -> Result<MassProps, Shap
     let finite =
         props.local_com.is_finite() && props.inertia.to_cols_array().iter().all(|x| x.is_finite());
     if !(props.mass.is_finite() && props.mass > 0.0 && finite) {
-        // Name the field that made it degenerate: a flat hull's points, otherwise the shape.
+        // Name the field that made it degenerate: a flat hull's points, otherwise the size.
         let field = match desc {
             ShapeDesc::ConvexHull { .. } => "points",
             ShapeDesc::Compound { .. } => "parts",
-            _ => "size",
+            ShapeDesc::Ball { .. } => "radius",
+            ShapeDesc::Cuboid { .. } => "half_extents",
+            _ => "radius",
         };
         return Err(ShapeError::invalid(
             field,
             format!(
-                "the {} has no usable mass (mass {})",
+                "the {} has no usable mass at density {density} kg/m³ (mass {}, inertia {}): \
+                 too small, too thin or too large for f32",
                 desc.kind(),
-                props.mass
+                props.mass,
+                props.inertia.diagonal()
             ),
         ));
     }

@@ -332,7 +332,11 @@ fn build_hull(points: &[Vec3]) -> Result<SharedShape, ShapeError> {
     if !spans_volume(points) {
         return Err(ShapeError::invalid(
             "points",
-            "the points are coplanar: the hull has no volume",
+            format!(
+                "the points are coplanar or collinear, or the hull is thinner than 10⁻⁶ of its \
+                 extent ({} m): it has no volume",
+                extent(points)
+            ),
         ));
     }
     SharedShape::convex_hull(points)
