@@ -232,14 +232,14 @@ pub fn sweep(
         let mut impact_time = None;
         let mut touch = None;
         let mut core_normal = None;
-        let touching = turning
-            && distance(&from, collider.shape.as_ref(), &to, target.shape.as_ref())
-                .is_ok_and(|d| d.distance <= settings.slop);
-        let hit = if touching {
-            // Already touching: parry's nonlinear cast, which then steps forward looking for
-            // an approach, returned 10⁻⁶ for a plate pivoting about a corner that was
-            // separating, and the plate was put back at the start of the step, step after
-            // step (benches/RESULTS.md, "CCD: no freeze, no tunnel"). Sampled instead.
+        let motion = shape.motion(delta.length(), angle);
+        // Already touching: parry's nonlinear cast, which then steps forward looking for an
+        // approach, returned 10⁻⁶ for a plate pivoting about a corner that was separating, and
+        // the plate was put back at the start of the step, step after step (benches/RESULTS.md,
+        // "CCD: no freeze, no tunnel"). Sampled instead; so is a turning body whose cast hits
+        // within one slop of its motion, which the back-off would put back at the start too (a
+        // wedge 5.5 mm above a floor, frozen for 236 steps).
+        let sampled = |touch: &mut Option<Witness>, impact_time: &mut Option<f32>| {
             let depth = (SAMPLED_DEPTH * shape.thickness).max(settings.slop);
             let step = (settings.motion_fraction * shape.thickness).max(settings.slop);
             let (hit, at) = sample_turning(
@@ -247,40 +247,46 @@ pub fn sweep(
                 &from,
                 delta,
                 rotation,
-                shape.motion(delta.length(), angle) / step,
+                motion / step,
                 target,
                 &to,
                 depth,
             );
             if let Some(Impact::At(_)) = hit {
-                impact_time = at.map(|a| a.0);
-                touch = at.map(|a| (a.1, a.2));
+                *impact_time = at.map(|a| a.0);
+                *touch = at.map(|a| (a.1, a.2));
             }
             hit
+        };
+        let touching = turning
+            && distance(&from, collider.shape.as_ref(), &to, target.shape.as_ref())
+                .is_ok_and(|d| d.distance <= settings.slop);
+        let hit = if touching {
+            sampled(&mut touch, &mut impact_time)
         } else if turning {
             match cast_turning(collider, &from, delta, rotation, target, &to) {
+                Ok((Some(Impact::At(t)), _)) if t * motion <= settings.slop => {
+                    sampled(&mut touch, &mut impact_time)
+                }
                 Ok((hit, at)) => {
                     if let Some(Impact::At(t)) = hit {
                         impact_time = Some(t);
                         touch = at;
                     }
-                    hit.map(|t| back_off(t, shape.motion(delta.length(), angle), settings.slop))
+                    hit.map(|t| back_off(t, motion, settings.slop))
                 }
                 // parry has no nonlinear cast for this pair (half-spaces, composite against
                 // composite): conservative advancement on parry's distance query.
-                Err(Unsupported) => {
-                    let speed = shape.motion(delta.length(), angle);
-                    advance(
-                        collider,
-                        &from,
-                        delta,
-                        rotation,
-                        speed,
-                        target,
-                        &to,
-                        settings.slop,
-                    )
-                }
+                Err(Unsupported) => advance(
+                    collider,
+                    &from,
+                    delta,
+                    rotation,
+                    motion,
+                    target,
+                    &to,
+                    settings.slop,
+                ),
             }
         } else {
             let (hit, at) = cast_linear(collider, &from, delta, target, &to, settings.slop);
