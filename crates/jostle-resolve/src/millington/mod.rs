@@ -104,7 +104,16 @@ pub struct MillingtonResolver {
     work: [PickWork; 2],
     /// Angular velocities before the position pass (scratch, reused between steps).
     spins: Vec<jostle_math::Vec3>,
+    /// Velocities before the velocity pass, and which bodies bounce only off immovable
+    /// bodies this step (scratch for `bound_bounce_energy`).
+    before_velocity: Vec<(jostle_math::Vec3, jostle_math::Vec3)>,
+    bounce_marks: Vec<u8>,
 }
+
+/// [`MillingtonResolver`]'s bounce marks: the body bounces off an immovable body.
+const BOUNCES_ON_FIXED: u8 = 1;
+/// The body touches a body that can move (energy may pass between them).
+const TOUCHES_MOVING: u8 = 2;
 
 impl MillingtonResolver {
     /// A resolver with the given settings.
@@ -208,6 +217,18 @@ impl MillingtonResolver {
             );
             p.target_velocity = p.velocity.x + p.desired_delta_velocity;
         }
+        mark_bounces(
+            &self.prepared,
+            bodies.len(),
+            settings.velocity_limit,
+            &mut self.bounce_marks,
+        );
+        self.before_velocity.clear();
+        self.before_velocity.extend(
+            bodies
+                .iter()
+                .map(|b| (b.linear_velocity, b.angular_velocity)),
+        );
         let mut pass = VelocityPass {
             contacts: &mut self.prepared,
             bodies,
@@ -224,6 +245,7 @@ impl MillingtonResolver {
             settings.velocity_epsilon,
         );
         self.work[1] = std::mem::take(&mut self.scratch.work);
+        bound_bounce_energy(&self.bounce_marks, &self.before_velocity, bodies);
         for (c, p) in contacts.iter_mut().zip(&self.prepared) {
             c.impulse = p.impulse;
             c.penetration = p.penetration;
@@ -261,5 +283,85 @@ impl Resolver for MillingtonResolver {
         stats.integrate_time = velocities_time + start.elapsed();
         stats.threads = 1;
         stats
+    }
+}
+
+/// Marks in `marks` the bodies with a contact of `prepared` that bounces this step
+/// (restitution above the velocity limit) against an immovable body, and those touching a body
+/// that can move.
+fn mark_bounces(
+    prepared: &[PreparedContact],
+    bodies: usize,
+    velocity_limit: f32,
+    marks: &mut Vec<u8>,
+) {
+    marks.clear();
+    marks.resize(bodies, 0);
+    for p in prepared {
+        let [a, b] = p.body;
+        let bounces = p.restitution > 0.0 && p.velocity.x <= -velocity_limit;
+        let mark = match (a == change::NO_BODY, b == change::NO_BODY) {
+            (false, false) => TOUCHES_MOVING,
+            (true, true) => continue,
+            _ if bounces => BOUNCES_ON_FIXED,
+            _ => continue,
+        };
+        for k in [a, b] {
+            if let Some(m) = marks.get_mut(k as usize) {
+                *m |= mark;
+            }
+        }
+    }
+}
+
+/// The energy bound of a bounce off immovable bodies: a body whose contacts this step are
+/// all with bodies that cannot move, one of them bouncing, leaves the velocity pass with no
+/// more kinetic energy than it entered it with; where it has more, the pass's change to its
+/// velocities is scaled back to the largest fraction that meets the bound (at least the
+/// inelastic half of it for e ≤ 1, so no contact is left approaching).
+///
+/// Why: each point bounces at −e times its own closing speed (Newton's rule, point by
+/// point). For a body striking with several points at once at different speeds (a
+/// spinning plate landing on an edge) those targets together can ask for more energy
+/// than the body brought: a 1 × 0.04 × 1 m plate hitting a wall at 20 m/s with e = 1
+/// left with 28% more (benches/RESULTS.md, "CCD: no freeze, no tunnel"). The soft step
+/// bounds its restitution pass the same way.
+fn bound_bounce_energy(
+    marks: &[u8],
+    before: &[(jostle_math::Vec3, jostle_math::Vec3)],
+    bodies: &mut [SolverBody],
+) {
+    for (i, &mark) in marks.iter().enumerate() {
+        if mark != BOUNCES_ON_FIXED {
+            continue;
+        }
+        let (Some(body), Some(&(v0, w0))) = (bodies.get_mut(i), before.get(i)) else {
+            continue;
+        };
+        if !(body.inv_mass > 0.0) {
+            continue;
+        }
+        let mass = 1.0 / body.inv_mass;
+        let det = body.inv_inertia.determinant();
+        let inertia = if det.is_finite() && det > 0.0 {
+            body.inv_inertia.inverse()
+        } else {
+            jostle_math::Mat3::ZERO
+        };
+        let energy = |v: jostle_math::Vec3, w: jostle_math::Vec3| {
+            0.5 * mass * v.length_squared() + 0.5 * w.dot(inertia * w)
+        };
+        let (dv, dw) = (body.linear_velocity - v0, body.angular_velocity - w0);
+        // K(s) = k + b·s + a·s² along the pass's change, s ∈ [0, 1]: K(s) = k at s = 0 and
+        // at s = −b/a, the largest fraction that keeps the bound.
+        let k = energy(v0, w0);
+        let a = energy(dv, dw);
+        let b = mass * v0.dot(dv) + w0.dot(inertia * dw);
+        if !(b + a > k * 1e-6) || !(a > 0.0) {
+            continue;
+        }
+        let s = (-b / a).clamp(0.0, 1.0);
+        body.linear_velocity = v0 + dv * s;
+        body.angular_velocity = w0 + dw * s;
     }
 }
