@@ -17,31 +17,31 @@
 //! every shot that fails (benches/RESULTS.md, "CCD: no freeze, no tunnel").
 
 use jostle::{BodyDesc, BodyHandle, Quat, ResolverChoice, ShapeDesc, Vec3, World, WorldSettings};
+use proptest::prelude::Rng as _;
+use proptest::test_runner::{RngAlgorithm, TestRng};
 
 const DT: f32 = 1.0 / 60.0;
 const STEPS: usize = 240;
 /// Shots per resolver in the CI part.
 const SHOTS: u64 = 48;
 
-/// SplitMix64: a small seeded generator, so every run sees the same shots.
-struct Rng(u64);
+/// proptest's seeded generator, so every run sees the same shots.
+struct Rng(TestRng);
 
 impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+    fn new(seed: u64) -> Self {
+        let mut bytes = [0u8; 32];
+        bytes[..8].copy_from_slice(&seed.to_le_bytes());
+        Self(TestRng::from_seed(RngAlgorithm::ChaCha, &bytes))
     }
 
     /// Uniform in [lo, hi).
     fn uniform(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * ((self.next() >> 40) as f32 / (1u64 << 24) as f32)
+        lo + (hi - lo) * ((self.0.next_u64() >> 40) as f32 / (1u64 << 24) as f32)
     }
 
     fn pick<T: Copy>(&mut self, items: &[T]) -> T {
-        items[(self.next() % items.len() as u64) as usize]
+        items[(self.0.next_u64() % items.len() as u64) as usize]
     }
 }
 
@@ -83,7 +83,7 @@ struct Shot {
 impl Shot {
     /// Shot number `index` of the family.
     fn new(index: u64) -> Self {
-        let mut rng = Rng(0x5EED_CCD0 ^ index.wrapping_mul(0x1000_0001));
+        let mut rng = Rng::new(0x5EED_CCD0 ^ index.wrapping_mul(0x1000_0001));
         let projectile = rng.pick(&[
             Projectile::Plate,
             Projectile::Plate,
@@ -281,7 +281,7 @@ fn no_soft_step_shot_gains_energy() {
 
 /// The whole of item 1 over 240 shots per resolver; prints every shot that fails.
 #[test]
-#[ignore = "open (issue 16 item 1): Millington bounces at e = 1 gain up to 4.7% (the step of gravity on the way out); a 1,000 m/s wedge ends past a 1 cm floor"]
+#[ignore = "open (issue 16 item 1): Millington bounces at e = 1 gain up to 7.7% of 2,000 shots (gravity on the way out of a bounce)"]
 fn every_shot_keeps_its_energy_in_both_resolvers() {
     // `CCD_SHOTS` sets the count (default 240).
     let shots: u64 = std::env::var("CCD_SHOTS")

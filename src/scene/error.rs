@@ -104,12 +104,7 @@ impl SceneError {
 /// The name of the `Body(...)` whose text encloses line/column, found from the source text:
 /// the last `Body(` before the position, and the first `name: "..."` after it.
 fn enclosing_body(text: &str, line: usize, column: usize) -> Option<String> {
-    let offset: usize = text
-        .split_inclusive('\n')
-        .take(line.saturating_sub(1))
-        .map(str::len)
-        .sum::<usize>()
-        + column.saturating_sub(1);
+    let offset = byte_offset(text, line, column);
     let before = text.get(..offset.min(text.len()))?;
     let start = before.rfind("Body(")?;
     // The position must still be inside that body's parentheses.
@@ -235,12 +230,7 @@ fn locate_setting(text: &str, field: &str) -> Option<(usize, usize)> {
 /// number is expected (`steps: 10.5` is read as 10 followed by `.5`: "Expected comma"), and
 /// an optional setting written with its type (`sleep: Some(SleepSettings(...))`).
 fn hint(text: &str, line: usize, column: usize, message: &str) -> Option<&'static str> {
-    let offset: usize = text
-        .split_inclusive('\n')
-        .take(line.saturating_sub(1))
-        .map(str::len)
-        .sum::<usize>()
-        + column.saturating_sub(1);
+    let offset = byte_offset(text, line, column);
     let here = text.get(offset.min(text.len())..)?;
     let before = text.get(..offset.min(text.len()))?;
     let after_digit = before.trim_end().ends_with(|c: char| c.is_ascii_digit());
@@ -257,4 +247,13 @@ fn hint(text: &str, line: usize, column: usize, message: &str) -> Option<&'stati
         );
     }
     None
+}
+
+/// Byte offset of `line` and `column` (from 1, as ron reports them) in `text`.
+fn byte_offset(text: &str, line: usize, column: usize) -> usize {
+    text.split_inclusive('\n')
+        .take(line.saturating_sub(1))
+        .map(str::len)
+        .sum::<usize>()
+        + column.saturating_sub(1)
 }
