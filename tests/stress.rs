@@ -136,11 +136,12 @@ fn a_million_to_one_load_never_pushes_a_body_through_the_floor_millington() {
     million_to_one(&resolvers()[..1]);
 }
 
-/// The same with the soft step: with the heavy box 3 mm off centre, the light box is pushed
-/// through the 10 cm floor (its centre at y = −0.064 at step 109; benches/RESULTS.md,
-/// "Colours beyond 64", which lists what is open of issue 16 item 6).
+/// The same with the soft step: with the heavy box 3 mm off centre, the light box is thrown
+/// 16.6 m sideways within one step, past the floor's edge, and falls (its centre at
+/// y = −0.064 at step 109; benches/RESULTS.md, "Colours beyond 64", which lists what is open
+/// of issue 16 item 6).
 #[test]
-#[ignore = "open (issue 16 item 6): at 1:10^6 the soft step pushes the light box through a 10 cm floor"]
+#[ignore = "open (issue 16 item 6): at 1:10^6 the soft step throws the light box 16.6 m sideways off the floor"]
 fn a_million_to_one_load_never_pushes_a_body_through_the_floor_soft_step() {
     million_to_one(&resolvers()[1..]);
 }

@@ -165,6 +165,13 @@ impl MillingtonSettings {
     pub const VELOCITY_EPSILON: f32 = 1e-4;
     /// jostle's default velocity budget per contact.
     pub const VELOCITY_PICKS_PER_CONTACT: u32 = 16;
+    /// Largest accepted `fixed` part of an iteration budget (picks per island and pass).
+    pub const MAX_FIXED_PICKS: u32 = 1 << 16;
+    /// Largest accepted `per_contact` part of an iteration budget: 1,024 picks per contact,
+    /// 64 times the default velocity budget. Beyond it a step of a few thousand contacts
+    /// could run for minutes (`velocity_iterations: 4294967295` made a first step that never
+    /// finished).
+    pub const MAX_PICKS_PER_CONTACT: u32 = 1024;
 
     /// Cyclone's settings: velocity epsilon 0.01 m/s and 4 velocity picks per contact, the
     /// rest as the defaults. Cheaper, but residual velocities below 0.01 m/s are left in every
@@ -196,6 +203,20 @@ impl MillingtonSettings {
         ] {
             if budget.for_contacts(1) == 0 {
                 return Err((field, "must allow at least one pick".into()));
+            }
+            if budget.fixed > Self::MAX_FIXED_PICKS
+                || budget.per_contact > Self::MAX_PICKS_PER_CONTACT
+            {
+                return Err((
+                    field,
+                    format!(
+                        "at most {} fixed picks and {} per contact, got (fixed: {}, per_contact: {})",
+                        Self::MAX_FIXED_PICKS,
+                        Self::MAX_PICKS_PER_CONTACT,
+                        budget.fixed,
+                        budget.per_contact
+                    ),
+                ));
             }
         }
         let non_negative = |field: &'static str, x: f32| {
@@ -254,6 +275,26 @@ mod tests {
             (
                 MillingtonSettings {
                     velocity_iterations: zero,
+                    ..Default::default()
+                },
+                "velocity_iterations",
+            ),
+            (
+                MillingtonSettings {
+                    position_iterations: IterationBudget {
+                        fixed: 8,
+                        per_contact: u32::MAX,
+                    },
+                    ..Default::default()
+                },
+                "position_iterations",
+            ),
+            (
+                MillingtonSettings {
+                    velocity_iterations: IterationBudget {
+                        fixed: u32::MAX,
+                        per_contact: 4,
+                    },
                     ..Default::default()
                 },
                 "velocity_iterations",
