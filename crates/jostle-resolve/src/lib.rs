@@ -12,6 +12,7 @@
 #![deny(missing_docs)]
 
 pub mod contact;
+mod energy;
 pub mod integrate;
 pub mod millington;
 pub mod resolver;

@@ -348,19 +348,18 @@ fn bound_bounce_energy(
         } else {
             jostle_math::Mat3::ZERO
         };
-        let energy = |v: jostle_math::Vec3, w: jostle_math::Vec3| {
-            0.5 * mass * v.length_squared() + 0.5 * w.dot(inertia * w)
-        };
         let (dv, dw) = (body.linear_velocity - v0, body.angular_velocity - w0);
-        // K(s) = k + b·s + a·s² along the pass's change, s ∈ [0, 1]: K(s) = k at s = 0 and
-        // at s = −b/a, the largest fraction that keeps the bound.
-        let k = energy(v0, w0);
-        let a = energy(dv, dw);
-        let b = mass * v0.dot(dv) + w0.dot(inertia * dw);
-        if !(b + a > k * 1e-6) || !(a > 0.0) {
+        let allowed = 0.5 * mass * v0.length_squared() + 0.5 * w0.dot(inertia * w0);
+        let Some(s) = crate::energy::bounded_fraction(
+            mass,
+            inertia,
+            (v0, w0),
+            (dv, dw),
+            allowed,
+            allowed * 1e-6,
+        ) else {
             continue;
-        }
-        let s = (-b / a).clamp(0.0, 1.0);
+        };
         body.linear_velocity = v0 + dv * s;
         body.angular_velocity = w0 + dw * s;
     }

@@ -399,18 +399,15 @@ impl SoftStepResolver {
             let allowed = energy(start.linear_velocity, start.angular_velocity, inertia)
                 + mass * gravity.dot(state.delta_position);
             let (dv, dw) = (state.linear_velocity - v_s, state.angular_velocity - w_s);
-            // K(s) = k + b·s + a·s² along the pass's change, s ∈ [0, 1].
-            let k = energy(v_s, w_s, inertia_now);
-            let a = energy(dv, dw, inertia_now);
-            let b = mass * v_s.dot(dv) + w_s.dot(inertia_now * dw);
-            if !(k + b + a > allowed) {
+            let Some(s) = crate::energy::bounded_fraction(
+                mass,
+                inertia_now,
+                (v_s, w_s),
+                (dv, dw),
+                allowed,
+                0.0,
+            ) else {
                 continue;
-            }
-            let s = if !(k < allowed) || !(a > 0.0) {
-                0.0
-            } else {
-                ((-b + (b * b - 4.0 * a * (k - allowed)).max(0.0).sqrt()) / (2.0 * a))
-                    .clamp(0.0, 1.0)
             };
             state.linear_velocity = v_s + dv * s;
             state.angular_velocity = w_s + dw * s;
