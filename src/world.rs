@@ -239,6 +239,28 @@ impl World {
             .ok_or(StepError::InvalidHandle(handle))
     }
 
+    /// Refuses velocities beyond [`crate::MAX_SPEED`] and [`crate::MAX_ANGULAR_SPEED`].
+    fn within_speed_limits(linear: Vec3, angular: Vec3) -> Result<(), StepError> {
+        let limit = |what, v: Vec3, limit: f32, unit| {
+            if v.length() <= limit {
+                Ok(())
+            } else {
+                Err(StepError::OutOfRange {
+                    what,
+                    value: format!("{:.3e} {unit}", v.length()),
+                    limit: format!("{limit:e} {unit}"),
+                })
+            }
+        };
+        limit("linear velocity", linear, crate::MAX_SPEED, "m/s")?;
+        limit(
+            "angular velocity",
+            angular,
+            crate::MAX_ANGULAR_SPEED,
+            "rad/s",
+        )
+    }
+
     fn finite(what: &'static str, v: Vec3) -> Result<(), StepError> {
         if v.is_finite() {
             Ok(())
@@ -278,7 +300,9 @@ impl World {
         Ok(())
     }
 
-    /// Applies an impulse (N·s) at a world point now; wakes the body's island.
+    /// Applies an impulse (N·s) at a world point now; wakes the body's island. Refused with
+    /// [`StepError::OutOfRange`], changing nothing, when the body's velocities after it would
+    /// exceed [`crate::MAX_SPEED`] or [`crate::MAX_ANGULAR_SPEED`].
     pub fn apply_impulse_at_point(
         &mut self,
         handle: BodyHandle,
@@ -287,6 +311,15 @@ impl World {
     ) -> Result<(), StepError> {
         Self::finite("impulse", impulse)?;
         Self::finite("point", point)?;
+        // Refused, changing nothing, when the velocities it would give are beyond the limits
+        // (a finite impulse of 1e30 N·s made the body non-finite in the next step).
+        let mut after = self
+            .bodies
+            .get(handle)
+            .ok_or(StepError::InvalidHandle(handle))?
+            .clone();
+        after.apply_impulse_at_point(impulse, point);
+        Self::within_speed_limits(after.linear_velocity, after.angular_velocity)?;
         self.body_mut_awake(handle)?
             .apply_impulse_at_point(impulse, point);
         Ok(())
@@ -323,24 +356,7 @@ impl World {
     ) -> Result<(), StepError> {
         Self::finite("linear velocity", linear)?;
         Self::finite("angular velocity", angular)?;
-        let limit = |what, v: Vec3, limit: f32, unit| {
-            if v.length() <= limit {
-                Ok(())
-            } else {
-                Err(StepError::OutOfRange {
-                    what,
-                    value: format!("{:.3e} {unit}", v.length()),
-                    limit: format!("{limit:e} {unit}"),
-                })
-            }
-        };
-        limit("linear velocity", linear, crate::MAX_SPEED, "m/s")?;
-        limit(
-            "angular velocity",
-            angular,
-            crate::MAX_ANGULAR_SPEED,
-            "rad/s",
-        )?;
+        Self::within_speed_limits(linear, angular)?;
         let body = self.body_mut_awake(handle)?;
         body.linear_velocity = linear;
         if !body.is_rotation_locked() {

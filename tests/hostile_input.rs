@@ -251,6 +251,18 @@ fn api_values_beyond_the_limits_are_refused() {
             .set_velocity(h, Vec3::new(0.0, 9.0e4, 0.0), Vec3::ZERO)
             .is_ok()
     );
+    // An impulse that would take the body past the limits is refused and changes nothing.
+    let before = world.body(h).expect("ball").linear_velocity;
+    assert!(matches!(
+        world.apply_impulse_at_point(h, Vec3::new(1.0e30, 0.0, 0.0), Vec3::ZERO),
+        Err(StepError::OutOfRange { .. })
+    ));
+    assert_eq!(world.body(h).expect("ball").linear_velocity, before);
+    assert!(
+        world
+            .apply_impulse_at_point(h, Vec3::new(1.0, 0.0, 0.0), Vec3::ZERO)
+            .is_ok()
+    );
     assert!(matches!(world.step(11.0), Err(StepError::InvalidDt(_))));
     assert!(world.step(10.0).is_ok());
 }
