@@ -13,6 +13,15 @@ fn asset(name: &str) -> PathBuf {
         .join(name)
 }
 
+/// Asserts that the command succeeded, showing its stderr when it did not.
+fn assert_ok(out: &std::process::Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 fn temp(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("jostle-cli-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -33,11 +42,7 @@ fn trace_of_a_free_fall_follows_semi_implicit_euler() {
         .arg("7")
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let text = std::fs::read_to_string(&trace).unwrap();
     let mut lines = text.lines();
     assert_eq!(
@@ -70,11 +75,7 @@ fn json_is_one_object_on_stdout() {
         .arg(asset("box_drop.ron"))
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let stdout = String::from_utf8(out.stdout).unwrap();
     assert_eq!(stdout.trim().lines().count(), 1);
     let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
@@ -336,11 +337,7 @@ fn a_snapshot_continues_the_trace_bit_for_bit() {
     let scene = asset("determinism.ron");
     let run = |args: &[&std::ffi::OsStr]| {
         let out = jostle().arg("run").args(args).output().unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        assert_ok(&out);
     };
     let (whole, first, second, snap) = (
         dir.join("whole.csv"),
@@ -475,11 +472,7 @@ fn outputs_never_overwrite_the_scene_each_other_or_an_untouched_file() {
         .args(["run", s, "--steps", "3", "--trace", c])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     assert!(std::fs::read_to_string(&csv).unwrap().lines().count() > 1);
     assert_eq!(std::fs::read_to_string(&scene).unwrap(), text);
 }
@@ -508,11 +501,7 @@ fn outputs_are_renamed_into_place_whole() {
         .args(["--size", "32x24", "--snapshot", snap.to_str().unwrap()])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let rows = std::fs::read_to_string(&trace).unwrap().lines().count();
     assert!(rows > 20, "{rows} trace lines");
     assert!(std::fs::read(&gif).unwrap().starts_with(b"GIF89a"));
