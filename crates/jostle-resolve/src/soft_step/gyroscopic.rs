@@ -26,6 +26,32 @@ pub fn inertia_of(inv_inertia: Mat3) -> Option<Mat3> {
     inertia.is_finite().then_some(inertia)
 }
 
+/// Relative anisotropy below which [`is_isotropic`] calls an inertia the same about every
+/// axis. The term's change to ω per turn is about the anisotropy times the turn, so at 10⁻⁵
+/// it is below f32 rounding for any turn of at most [`MAX_PIECE_ANGLE`] per piece.
+pub const ISOTROPY_TOLERANCE: f32 = 1e-5;
+
+/// Whether the world inverse inertia `inv_inertia` is a multiple of the identity to within
+/// [`ISOTROPY_TOLERANCE`] of its diagonal's mean (a ball, a cube, any body whose principal
+/// moments are equal): then L = I·ω turns with ω, ω × I·ω = 0, and the gyroscopic term
+/// changes nothing. Skipping it saved the 20-row pyramid of cubes at four substeps a fifth of
+/// its step (`gyroscopic::rotate_inertia` and `turn_against` were 20% of it under `perf`,
+/// the boxes turning slightly above [`super::integrate::GYROSCOPIC_CUTOFF`]).
+pub fn is_isotropic(inv_inertia: Mat3) -> bool {
+    let mean = (inv_inertia.x_axis.x + inv_inertia.y_axis.y + inv_inertia.z_axis.z) / 3.0;
+    if !(mean.is_finite() && mean > 0.0) {
+        return false;
+    }
+    let d = inv_inertia - Mat3::from_diagonal(Vec3::splat(mean));
+    let largest = d
+        .x_axis
+        .abs()
+        .max(d.y_axis.abs())
+        .max(d.z_axis.abs())
+        .max_element();
+    largest <= ISOTROPY_TOLERANCE * mean
+}
+
 /// The world inertia at the start of the step, `inertia`, carried along by the rotation
 /// `delta` the body made since: R·I·Rᵀ. Keeps the gyroscopic torque consistent with the
 /// body's current orientation within the step, which a fixed tensor would not be.
@@ -227,8 +253,22 @@ mod tests {
     }
 
     #[test]
+    fn cubes_are_isotropic_at_any_orientation_and_a_brick_is_not() {
+        let r = Mat3::from_quat(
+            Quat::from_rotation_x(0.3) * Quat::from_rotation_y(1.1) * Quat::from_rotation_z(-0.7),
+        );
+        let turned = |d: Vec3| r * Mat3::from_diagonal(d) * r.transpose();
+        assert!(is_isotropic(turned(Vec3::splat(6.0))));
+        // Anisotropy 10⁻⁴, ten times the tolerance.
+        assert!(!is_isotropic(turned(Vec3::new(6.0, 6.0, 6.0006))));
+        assert!(!is_isotropic(Mat3::ZERO));
+        assert!(!is_isotropic(Mat3::from_diagonal(Vec3::new(1.0, 1.0, 0.0))));
+    }
+
+    #[test]
     fn singular_inverse_inertia_has_no_inertia() {
         assert!(inertia_of(Mat3::ZERO).is_none());
+
         assert!(inertia_of(Mat3::from_diagonal(Vec3::new(1.0, 0.0, 1.0))).is_none());
         let i = inertia_of(Mat3::from_diagonal(Vec3::new(2.0, 4.0, 0.5))).unwrap();
         assert!((i * Vec3::ONE - Vec3::new(0.5, 0.25, 2.0)).length() < 1e-6);

@@ -259,7 +259,9 @@ impl SoftStepResolver {
         &self.batches
     }
 
-    /// Loads the body states and, with the gyroscopic term on, the step-start inertia tensors.
+    /// Loads the body states and, with the gyroscopic term on, the step-start inertia tensors
+    /// (zero for a body whose inertia is the same about every axis: a ball or a cube keeps
+    /// L = I·ω with ω itself, and its turns need no term; `gyroscopic::is_isotropic`).
     fn load_bodies(&mut self, bodies: &[SolverBody]) {
         self.states.clear();
         self.states.extend(bodies.iter().map(BodyState::from_body));
@@ -271,7 +273,7 @@ impl SoftStepResolver {
         self.inertia.clear();
         if self.settings.gyroscopic {
             self.inertia.extend(bodies.iter().map(|b| {
-                if b.rotates() {
+                if b.rotates() && !gyroscopic::is_isotropic(b.inv_inertia) {
                     gyroscopic::inertia_of(b.inv_inertia).unwrap_or(Mat3::ZERO)
                 } else {
                     Mat3::ZERO
