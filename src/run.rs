@@ -178,10 +178,25 @@ pub struct RunSetup {
 /// Overrides a command line applies on top of a scene's or snapshot's settings.
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
-    /// Another resolver.
+    /// Another resolver. A scene or snapshot that already names the same resolver keeps its
+    /// own settings for it ([`Overrides::apply_resolver`]).
     pub resolver: Option<crate::ResolverChoice>,
     /// Sleeping on or off.
     pub sleep: Option<bool>,
+}
+
+impl Overrides {
+    /// Applies the resolver override to `own`, the resolver a scene or snapshot names: a
+    /// different resolver replaces it (with the override's settings), the same one leaves
+    /// `own` and its settings as they are. `--resolver millington` on a scene that declares
+    /// `Millington(velocity_iterations: 64)` runs those 64 iterations.
+    pub fn apply_resolver(&self, own: &mut crate::ResolverChoice) {
+        if let Some(r) = &self.resolver
+            && r.name() != own.name()
+        {
+            *own = r.clone();
+        }
+    }
 }
 
 /// Loads a scene file, or a snapshot written by `jostle run --snapshot` (recognised by its
@@ -195,9 +210,7 @@ pub fn load(path: &std::path::Path, overrides: &Overrides) -> Result<RunSetup, L
         .map_err(|e| LoadError::Io(format!("{file}: cannot read: {e}")))?;
     if Snapshot::is_snapshot_text(&text) {
         let mut snapshot = Snapshot::parse(&text, &file)?;
-        if let Some(r) = &overrides.resolver {
-            snapshot.settings.resolver = r.clone();
-        }
+        overrides.apply_resolver(&mut snapshot.settings.resolver);
         if let Some(on) = overrides.sleep {
             snapshot.settings.sleep.enabled = on;
         }
@@ -221,9 +234,7 @@ pub fn load(path: &std::path::Path, overrides: &Overrides) -> Result<RunSetup, L
     }
     let scene = Scene::parse(&text, &file)?;
     let mut settings = scene.settings();
-    if let Some(r) = &overrides.resolver {
-        settings.resolver = r.clone();
-    }
+    overrides.apply_resolver(&mut settings.resolver);
     if let Some(on) = overrides.sleep {
         settings.sleep.enabled = on;
     }
@@ -252,4 +263,48 @@ pub enum LoadError {
     /// A bad snapshot.
     #[error(transparent)]
     Snapshot(#[from] crate::snapshot::SnapshotError),
+}
+
+#[cfg(all(test, feature = "scene"))]
+mod tests {
+    use super::*;
+    use crate::{MillingtonSettings, ResolverChoice, SoftStepSettings};
+
+    fn resolver_after(scene: &str, name: &str) -> ResolverChoice {
+        let path = std::env::temp_dir().join(format!(
+            "jostle-run-override-{}-{name}.ron",
+            std::process::id()
+        ));
+        std::fs::write(&path, scene).unwrap();
+        let overrides = Overrides {
+            resolver: Some(ResolverChoice::from_name(name).unwrap()),
+            sleep: None,
+        };
+        let setup = load(&path, &overrides);
+        let _ = std::fs::remove_file(&path);
+        setup.unwrap().world.settings().resolver.clone()
+    }
+
+    #[test]
+    fn naming_the_scenes_own_resolver_keeps_its_settings() {
+        let scene = "Scene(resolver: Millington(velocity_iterations: 64, relaxation: 0.5))";
+        let Some(own) = crate::scene::Scene::parse(scene, "t.ron").unwrap().resolver else {
+            panic!("the scene names a resolver")
+        };
+        assert_eq!(resolver_after(scene, "millington"), own);
+        assert_ne!(
+            own,
+            ResolverChoice::Millington(MillingtonSettings::default())
+        );
+        // Another resolver replaces it, at its defaults.
+        assert_eq!(
+            resolver_after(scene, "soft-step"),
+            ResolverChoice::SoftStep(SoftStepSettings::default())
+        );
+        let scene = "Scene(resolver: SoftStep(substeps: 3))";
+        assert!(matches!(
+            resolver_after(scene, "soft-step"),
+            ResolverChoice::SoftStep(s) if s.substeps == 3
+        ));
+    }
 }

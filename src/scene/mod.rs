@@ -15,7 +15,7 @@
 //! ```
 //!
 //! Every field but a body's `shape` has a default: scene `name` "unnamed", `gravity`
-//! (0, −9.81, 0), `dt` 1/60 s, `steps` 600, `resolver` the engine's best, `sleep` enabled with
+//! (0, −9.81, 0), `dt` 1/60 s, `steps` 600, `resolver` the soft step at its defaults, `sleep` enabled with
 //! threshold 0.3; body `name` "", `position` origin, `rotation` identity (x, y, z, w), zero
 //! velocities, `density` 1000 kg/m³ unless `mass` (kg) is given, `friction` 0.5,
 //! `restitution` 0, damping 0, `can_sleep` true, `fixed` false, `ccd` Auto. `generators` add many bodies
@@ -81,7 +81,8 @@ pub struct Scene {
     /// Steps to run. Default 600.
     #[serde(default = "default_steps")]
     pub steps: u32,
-    /// The resolver and its settings. Default: the engine's best.
+    /// The resolver and its settings. Default: the soft step at its defaults
+    /// ([`crate::ResolverChoice::default`]).
     #[serde(default)]
     pub resolver: Option<ResolverChoice>,
     /// Sleep settings. Default: enabled, threshold 0.3, bias base 0.5.

@@ -25,7 +25,8 @@ pub struct RunArgs {
     /// Time step in seconds (default: the scene's `dt`).
     #[arg(long)]
     dt: Option<f32>,
-    /// Resolver: millington or soft-step (default: the scene's, else the engine's best).
+    /// Resolver: millington or soft-step (default: the scene's, else soft-step). A scene that
+    /// names the same resolver keeps its settings for it.
     #[arg(long)]
     resolver: Option<String>,
     /// Write a CSV trace of every dynamic body to this file.

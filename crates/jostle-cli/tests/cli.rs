@@ -54,7 +54,7 @@ fn trace_of_a_free_fall_follows_semi_implicit_euler() {
     let mut expected: Vec<u64> = (0..=90).filter(|s| s % 7 == 0).collect();
     expected.push(90);
     assert_eq!(steps, expected, "step 0, every 7th, and the last");
-    // The default resolver (the soft step) integrates in substeps of h = dt / 4.
+    // The default resolver (the soft step) integrates in substeps of h = dt / substeps.
     let substeps = jostle::SoftStepSettings::default().substeps as f64;
     let h = 1.0f64 / 60.0 / substeps;
     for r in &rows {
@@ -518,4 +518,49 @@ fn outputs_are_renamed_into_place_whole() {
         names.iter().all(|n| !n.contains("jostle-partial")),
         "left behind: {names:?}"
     );
+}
+
+/// The lecture's examples through the command line: `--resolver millington` on a scene that
+/// names Millington keeps the scene's settings, and the traced step gives the printed digits
+/// (the second example's cube on its edge: v_y 0.6234 and ω_z 0.1715, from rounded
+/// intermediates, so to ±2·10⁻⁴).
+#[test]
+fn the_lecture_examples_run_through_the_command_line() {
+    let trace = temp("lecture_2.csv");
+    let out = jostle()
+        .arg("run")
+        .arg(asset("lecture_2_cube_edge.ron"))
+        .args(["--resolver", "millington", "--trace"])
+        .arg(&trace)
+        .output()
+        .unwrap();
+    assert_ok(&out);
+    let text = std::fs::read_to_string(&trace).unwrap();
+    let last: Vec<f64> = text
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .skip(3)
+        .take(13)
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let (vx, vy, wx, wz) = (last[7], last[8], last[10], last[12]);
+    assert!((vx - 2.165).abs() < 1e-4, "{text}");
+    assert!((vy - 0.6234).abs() < 2e-4, "{text}");
+    assert!((wz - 0.1715).abs() < 2e-4, "{text}");
+    assert!(wx.abs() < 1e-5, "no spin about x: {text}");
+    for file in [
+        "lecture_1_spheres.ron",
+        "lecture_2_cube_face.ron",
+        "lecture_3_projection.ron",
+    ] {
+        let out = jostle()
+            .arg("run")
+            .arg(asset(file))
+            .args(["--resolver", "millington", "--json"])
+            .output()
+            .unwrap();
+        assert_ok(&out);
+    }
 }
