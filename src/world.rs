@@ -10,8 +10,8 @@ use crate::settings::WorldSettings;
 use crate::stages::{self, Scratch};
 use jostle_body::{BodyHandle, BodySet, RigidBody};
 use jostle_collide::{
-    BodyContact, BroadPhase, CcdShape, Collider, ColliderSet, CollisionEvent, NarrowPhase, RayHit,
-    mass_properties,
+    BodyContact, BroadPhase, CcdShape, Collider, ColliderSet, CollisionEvent, NarrowPhase, Queries,
+    QueryFilter, RayHit, mass_properties,
 };
 use jostle_math::{Quat, Vec3};
 use jostle_resolve::{Resolver, StepContext};
@@ -79,6 +79,10 @@ pub struct World {
     pub(crate) time: f64,
     pub(crate) steps: u64,
     scratch: Scratch,
+    /// Counts the changes that can move or add a collider (steps, added bodies, every mutable
+    /// access to a body); the broad phase's tree serves queries while `query_stamp` equals it.
+    stamp: u64,
+    query_stamp: u64,
 }
 
 impl World {
@@ -101,6 +105,8 @@ impl World {
             time: 0.0,
             steps: 0,
             scratch: Scratch::default(),
+            stamp: 1,
+            query_stamp: 0,
         }
     }
 
@@ -124,6 +130,7 @@ impl World {
     /// `desc.position` by the rotated centre-of-mass offset.
     pub fn add_body(&mut self, desc: BodyDesc) -> Result<BodyHandle, BodyError> {
         desc.validate()?;
+        self.stamp += 1;
         let shape = desc.shape.build().map_err(|e| shape_error(&desc.name, e))?;
         let rotation = unit_rotation(desc.rotation).unwrap_or(Quat::IDENTITY);
         let (body, local_pose) = if desc.fixed {
@@ -232,6 +239,7 @@ impl World {
         if !self.bodies.contains(handle) {
             return Err(StepError::InvalidHandle(handle));
         }
+        self.stamp += 1;
         self.islands
             .wake(&mut self.bodies, handle, &self.settings.sleep);
         self.bodies
@@ -451,9 +459,62 @@ impl World {
             .sum()
     }
 
-    /// The first body hit by a ray from `origin` along `dir` within `max_distance` (m).
+    /// The first body hit by a ray from `origin` along `dir` within `max_distance` (m), of
+    /// every body: [`World::queries`]'s [`Queries::ray_cast`] with no filter.
     pub fn ray_cast(&self, origin: Vec3, dir: Vec3, max_distance: f32) -> Option<RayHit> {
-        jostle_collide::ray_cast(&self.colliders, &self.bodies, origin, dir, max_distance)
+        self.queries()
+            .ray_cast(origin, dir, max_distance, &QueryFilter::default())
+    }
+
+    /// The scene queries at the bodies' current poses: rays (first hit and all hits), shape
+    /// casts, point projection and shape overlap, each with a [`QueryFilter`].
+    ///
+    /// After [`World::update_queries`], and until the next step or change to a body, they run
+    /// through the broad phase's tree: a ray among 10,000 colliders costs about what it costs
+    /// among 100 (`cargo bench --bench queries`). Otherwise every collider is tested: the same
+    /// results, at a cost that grows with the collider count. So call `update_queries` once
+    /// after each step when a step is followed by many queries.
+    ///
+    /// ```
+    /// use jostle::{BodyDesc, QueryFilter, ShapeDesc, Vec3, World, WorldSettings};
+    ///
+    /// let mut world = World::new(WorldSettings::default());
+    /// world.add_body(BodyDesc::fixed("ground", ShapeDesc::HalfSpace { normal: Vec3::Y })).unwrap();
+    /// let player = world
+    ///     .add_body(BodyDesc::dynamic("player", ShapeDesc::Ball { radius: 0.5 }).at(Vec3::new(0.0, 3.0, 0.0)))
+    ///     .unwrap();
+    /// world.update_queries();
+    /// // How far below the player is the ground? Its own collider is skipped.
+    /// let down = world
+    ///     .queries()
+    ///     .ray_cast(Vec3::new(0.0, 3.0, 0.0), -Vec3::Y, 10.0, &QueryFilter::excluding(player))
+    ///     .unwrap();
+    /// assert!((down.distance - 3.0).abs() < 1e-5);
+    /// ```
+    pub fn queries(&self) -> Queries<'_> {
+        if self.query_stamp == self.stamp {
+            Queries::with_tree(&self.colliders, &self.bodies, &self.broad)
+        } else {
+            Queries::brute_force(&self.colliders, &self.bodies)
+        }
+    }
+
+    /// Brings the broad phase's tree up to the bodies' current poses, so that
+    /// [`World::queries`] run through it until the next step or change to a body. Costs about
+    /// what the broad phase's own pose check costs at the start of a step (one comparison per
+    /// collider, a tree update per collider that moved out of its box); changes no result of
+    /// any later step (tested).
+    pub fn update_queries(&mut self) {
+        if self.query_stamp != self.stamp {
+            self.broad.refresh(&self.colliders, &self.bodies);
+            self.query_stamp = self.stamp;
+        }
+    }
+
+    /// Whether [`World::queries`] run through the tree now ([`World::update_queries`] was
+    /// called since the last step or change to a body).
+    pub fn queries_use_tree(&self) -> bool {
+        self.query_stamp == self.stamp
     }
 
     /// Advances the world by `dt` seconds: the pipeline of ARCHITECTURE.md ("The step"), each stage timed into
@@ -554,6 +615,7 @@ impl World {
         self.profile = p;
         self.time += dt as f64;
         self.steps += 1;
+        self.stamp += 1;
         Ok(report)
     }
 

@@ -214,6 +214,46 @@ impl BroadPhase {
         &self.pairs
     }
 
+    /// Brings the tree up to the colliders' current poses without looking for pairs: after
+    /// it, every live collider's box in the tree contains its shape at its current pose, so
+    /// the scene queries ([`crate::query::Queries`]) can prune with the tree. Costs what the
+    /// proxy pass of [`BroadPhase::update`] costs (a pose comparison per collider, a leaf
+    /// rewrite per collider that left its fat box); the next update then finds those leaves
+    /// current. Never changes the pairs any update reports.
+    pub fn refresh(&mut self, colliders: &ColliderSet, bodies: &BodySet) {
+        // Before any update there is no margin yet: boxes are exact, and the first update
+        // (its margin differing) recomputes them all.
+        if self.margin.is_nan() {
+            self.margin = 0.0;
+        }
+        if self.update_proxies(colliders, bodies, false) {
+            self.tree.refit(&mut self.workspace);
+            self.tree.optimize_incremental(&mut self.workspace);
+        }
+    }
+
+    /// Walks the tree: `visit(aabb, leaf)` is called for each node reached, with `leaf` the
+    /// collider of a leaf node (`None` for an inner node), and the walk descends below a node
+    /// only when `visit` returns true. The boxes contain each collider's enlarged box of the
+    /// last [`BroadPhase::update`] or [`BroadPhase::refresh`]. Unbounded colliders
+    /// (half-spaces) are not in the tree: see [`BroadPhase::unbounded_colliders`].
+    pub fn traverse(&self, mut visit: impl FnMut(&Aabb, Option<ColliderHandle>) -> bool) {
+        use parry3d::partitioning::TraversalAction;
+        self.tree.traverse(|node| {
+            let leaf = node.leaf_data().map(|i| self.handle(i));
+            if visit(&node.aabb(), leaf) {
+                TraversalAction::Continue
+            } else {
+                TraversalAction::Prune
+            }
+        });
+    }
+
+    /// The unbounded colliders (half-spaces) as of the last update or refresh.
+    pub fn unbounded_colliders(&self) -> impl Iterator<Item = ColliderHandle> + '_ {
+        self.unbounded.iter().map(|&u| self.handle(u))
+    }
+
     /// Brings every proxy up to date with its collider; returns whether the tree changed.
     fn update_proxies(&mut self, colliders: &ColliderSet, bodies: &BodySet, force: bool) -> bool {
         let n = colliders.capacity_index();

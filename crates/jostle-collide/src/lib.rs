@@ -35,6 +35,6 @@ pub use narrow_phase::{BodyContact, CollisionEvent, NarrowPhase, NarrowStats};
 pub use parry3d;
 pub use parry3d::math::Pose;
 pub use parry3d::shape::SharedShape;
-pub use query::{RayHit, intersect_shape, ray_cast};
+pub use query::{PointHit, Queries, QueryFilter, RayHit, ShapeHit, intersect_shape, ray_cast};
 pub use settings::{CcdSettings, CollideSettings};
 pub use shape::{CompoundPart, ShapeDesc, ShapeError};
