@@ -117,10 +117,7 @@ impl BodyDesc {
             linear_velocity: Vec3::ZERO,
             angular_velocity: Vec3::ZERO,
             mass: MassSpec::Density(DEFAULT_DENSITY),
-            material: Material {
-                friction: 0.5,
-                restitution: 0.0,
-            },
+            material: Material::new(0.5, 0.0),
             linear_damping: 0.0,
             angular_damping: 0.0,
             can_sleep: true,
@@ -181,12 +178,16 @@ impl BodyDesc {
         self
     }
 
-    /// Sets friction and restitution.
+    /// Sets friction (static and dynamic alike) and restitution.
     pub fn with_material(mut self, friction: f32, restitution: f32) -> Self {
-        self.material = Material {
-            friction,
-            restitution,
-        };
+        self.material = Material::new(friction, restitution);
+        self
+    }
+
+    /// Sets a dynamic friction coefficient of its own, μd ≤ the static `friction`: a
+    /// contact that is sliding feels μd, one that is not is held by up to `friction`.
+    pub fn with_dynamic_friction(mut self, dynamic: f32) -> Self {
+        self.material.dynamic_friction = Some(dynamic);
         self
     }
 
@@ -265,6 +266,18 @@ impl BodyDesc {
             }
         };
         non_negative("friction", self.material.friction)?;
+        if let Some(d) = self.material.dynamic_friction {
+            non_negative("dynamic_friction", d)?;
+            if d > self.material.friction {
+                return Err(err(
+                    "dynamic_friction",
+                    format!(
+                        "must be <= friction (the static coefficient, {}), got {d}",
+                        self.material.friction
+                    ),
+                ));
+            }
+        }
         non_negative("linear_damping", self.linear_damping)?;
         non_negative("angular_damping", self.angular_damping)?;
         let e = self.material.restitution;

@@ -305,6 +305,14 @@ mod file {
                         m.friction
                     )));
                 }
+                if let Some(d) = m.dynamic_friction
+                    && !(0.0..=m.friction).contains(&d)
+                {
+                    return Err(invalid(format!(
+                        "collider {i}: material.dynamic_friction: must be in [0, friction = {}], got {d}",
+                        m.friction
+                    )));
+                }
                 if !(m.restitution.is_finite() && (0.0..=1.0).contains(&m.restitution)) {
                     return Err(invalid(format!(
                         "collider {i}: material.restitution: must be in [0, 1], got {}",

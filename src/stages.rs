@@ -36,6 +36,30 @@ pub(crate) struct Scratch {
     pub ccd_fast: Vec<bool>,
     /// CCD: (body slot, collider hit) of every stop of the previous step, sorted.
     pub ccd_previous: Vec<(u32, ColliderHandle)>,
+    /// For each narrow-phase contact whose materials have a dynamic friction coefficient of
+    /// their own, whether it is sliding ([`sliding`]); empty when none has.
+    pub sliding: Vec<bool>,
+}
+
+/// Relative tangential speed (m/s) at a contact, at the end of the last step, above which the
+/// contact is sliding: its friction this step is the materials' dynamic coefficient
+/// ([`jostle_collide::Material::dynamic_friction`]), at or below it the static one holds it.
+/// 1 cm/s: far above the residual speeds of a resting stack (below 10⁻⁴ m/s), far below any
+/// sliding one cares to see decelerate.
+pub const SLIDING_SPEED: f32 = 0.01;
+
+/// Whether contact `c` is sliding: the relative velocity of its two surface points, less its
+/// normal part, is faster than [`SLIDING_SPEED`]. Read from the bodies' velocities before this
+/// step's forces (which a resolver's friction answers, not a sliding contact) and gravity.
+fn sliding(bodies: &BodySet, c: &BodyContact) -> bool {
+    let at = |h, p: Vec3| {
+        bodies.get(h).map_or(Vec3::ZERO, |b| {
+            b.linear_velocity + b.angular_velocity.cross(p - b.position)
+        })
+    };
+    let v = at(c.a, c.point) - at(c.b, c.point_b);
+    let tangential = v - c.normal * v.dot(c.normal);
+    tangential.length_squared() > SLIDING_SPEED * SLIDING_SPEED
 }
 
 /// A body CCD stops: where, and on what.
@@ -92,6 +116,17 @@ pub(crate) fn gather(
     report: &mut StepReport,
     names: &[String],
 ) {
+    // Which contacts slide, before the forces change the velocities; only where a dynamic
+    // coefficient differs from the static one (every other scene skips this).
+    scratch.sliding.clear();
+    if contacts
+        .iter()
+        .any(|c| c.dynamic_friction.is_some_and(|d| d != c.friction))
+    {
+        scratch
+            .sliding
+            .extend(contacts.iter().map(|c| sliding(bodies, c)));
+    }
     scratch.bodies.clear();
     scratch.bodies.push(SolverBody::STATIC);
     scratch.body_slot.clear();
@@ -104,6 +139,7 @@ pub(crate) fn gather(
         if !body.is_awake() {
             continue;
         }
+        let (v0, w0) = (body.linear_velocity, body.angular_velocity);
         apply_forces(body, dt);
         if !body.is_finite() {
             body.freeze();
@@ -120,8 +156,11 @@ pub(crate) fn gather(
             body.inv_mass(),
             body.inv_inertia_world(),
         );
-        sb.linear_velocity = body.linear_velocity;
-        sb.angular_velocity = body.angular_velocity;
+        // The forces' velocity change goes to the resolver to add over the step, not at once.
+        sb.linear_velocity = v0;
+        sb.angular_velocity = w0;
+        sb.force_velocity = body.linear_velocity - v0;
+        sb.torque_velocity = body.angular_velocity - w0;
         sb.last_acceleration = body.last_acceleration;
         scratch.bodies.push(sb);
     }
@@ -143,8 +182,14 @@ pub(crate) fn gather(
         if a == STATIC_BODY && b == STATIC_BODY {
             continue;
         }
+        // Static friction holds a contact that is not sliding; a sliding one feels the
+        // dynamic coefficient for this step.
+        let friction = match c.dynamic_friction {
+            Some(d) if scratch.sliding.get(i).copied().unwrap_or(false) => d,
+            _ => c.friction,
+        };
         let mut contact = Contact::new(a, b, c.point, c.normal, c.penetration)
-            .with_friction(c.friction)
+            .with_friction(friction)
             .with_restitution(c.restitution);
         contact.impulse = c.impulse;
         contact.point_b = c.point_b;

@@ -158,10 +158,7 @@ fn spacing() -> f32 {
 fn cuboid(name: String, h: Vec3, centre: Vec3, friction: f32, density: f32) -> BodyDesc {
     let mut d = BodyDesc::dynamic(name, ShapeDesc::Cuboid { half_extents: h }).at(centre);
     d.mass = MassSpec::Density(density);
-    d.material = Material {
-        friction,
-        restitution: 0.0,
-    };
+    d.material = Material::new(friction, 0.0);
     d
 }
 

@@ -17,8 +17,8 @@
 //! Every field but a body's `shape` has a default: scene `name` "unnamed", `gravity`
 //! (0, −9.81, 0), `dt` 1/60 s, `steps` 600, `resolver` the soft step at its defaults, `sleep` enabled with
 //! threshold 0.3; body `name` "", `position` origin, `rotation` identity (x, y, z, w), zero
-//! velocities, `density` 1000 kg/m³ unless `mass` (kg) is given, `friction` 0.5,
-//! `restitution` 0, damping 0, `can_sleep` true, `fixed` false, `ccd` Auto. `generators` add many bodies
+//! velocities, `density` 1000 kg/m³ unless `mass` (kg) is given, `friction` 0.5 (static;
+//! `dynamic_friction`, at most that, defaults to it), `restitution` 0, damping 0, `can_sleep` true, `fixed` false, `ccd` Auto. `generators` add many bodies
 //! from a few parameters (pyramids, stacks, walls, grids of piles); an optional `perturb`
 //! ([`Perturb`]) shifts and turns them a little from a seed, so a file gives a reproducible
 //! perturbed start. An optional `camera`
@@ -192,9 +192,14 @@ pub struct BodySpec {
     /// Density (kg/m³); default 1000 when `mass` is not given.
     #[serde(default)]
     pub density: Option<f32>,
-    /// Friction coefficient μ. Default 0.5.
+    /// Friction coefficient μ: the static one, holding a contact that is not sliding.
+    /// Default 0.5.
     #[serde(default = "default_friction")]
     pub friction: f32,
+    /// Dynamic friction coefficient μd, acting on a sliding contact; at most `friction`.
+    /// Default: the same as `friction`.
+    #[serde(default)]
+    pub dynamic_friction: Option<f32>,
     /// Restitution e in [0, 1]. Default 0.
     #[serde(default)]
     pub restitution: f32,
@@ -248,6 +253,7 @@ impl BodySpec {
             material: Material {
                 friction: self.friction,
                 restitution: self.restitution,
+                dynamic_friction: self.dynamic_friction,
             },
             linear_damping: self.linear_damping,
             angular_damping: self.angular_damping,

@@ -47,8 +47,15 @@ pub struct BodyContact {
     /// Penetration depth along the normal (m): positive on overlap, negative (the separation)
     /// for a speculative contact within the prediction distance.
     pub penetration: f32,
-    /// Mixed friction coefficient ([`Material::mix`]).
+    /// Mixed friction coefficient ([`Material::mix`]): the static one, μs.
     pub friction: f32,
+    /// Mixed dynamic friction coefficient μd when the materials have one of their own
+    /// ([`Material::dynamic_friction`]); `None`: the same as `friction`.
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Option::is_none")
+    )]
+    pub dynamic_friction: Option<f32>,
     /// Mixed restitution ([`Material::mix`]).
     pub restitution: f32,
     /// The resolver's accumulated impulse of the last step for this point, in contact space
@@ -311,8 +318,11 @@ impl NarrowPhase {
                 && c.preload.is_finite()
                 && c.preload >= 0.0;
             let unit = c.normal.is_finite() && (c.normal.length() - 1.0).abs() < 1e-3;
-            let material =
-                c.friction.is_finite() && c.friction >= 0.0 && (0.0..=1.0).contains(&c.restitution);
+            let material = c.friction.is_finite()
+                && c.friction >= 0.0
+                && c.dynamic_friction
+                    .is_none_or(|d| (0.0..=c.friction).contains(&d))
+                && (0.0..=1.0).contains(&c.restitution);
             if !(finite && unit && material) {
                 return Err(format!(
                     "contacts[{i}]: a number is not finite or out of its domain"
@@ -512,6 +522,7 @@ impl NarrowPhase {
                         normal: frame.normal,
                         penetration: -pt.dist,
                         friction: material.friction,
+                        dynamic_friction: material.dynamic_friction,
                         restitution: material.restitution,
                         impulse: pt.data.impulse,
                         preload: pt.data.preload,

@@ -43,8 +43,11 @@ pub struct ResolveStats {
 /// - `bodies[STATIC_BODY]` is [`SolverBody::STATIC`] and must not be written. Every other
 ///   entry is an awake dynamic body; the resolver **owns its integration**: it applies gravity
 ///   to velocities, integrates velocities into poses (semi-implicit Euler, orientation by
-///   [`jostle_math::integrate_orientation`]) and records `last_acceleration`. Forces have
-///   already been applied to velocities by the caller.
+///   [`jostle_math::integrate_orientation`]) and records `last_acceleration`. The velocity
+///   change of the step's applied forces and damping comes separately
+///   ([`SolverBody::force_velocity`], [`SolverBody::torque_velocity`]) and the resolver adds
+///   it over the step as it adds gravity ([`crate::integrate::integrate_velocities`] does
+///   both), so that what friction holds is held within each substep.
 /// - `contacts` were detected on the poses the bodies have on entry. The resolver may reorder
 ///   nothing and must write each contact's `impulse` (contact space, on A); it may update
 ///   `penetration` to the value it believes remains.

@@ -39,9 +39,18 @@ pub struct SolverBody {
     /// from closing velocities. jostle records gravity here (forces are applied as impulses
     /// before the resolver runs; the lecture allows "ignoring any force except gravity").
     pub last_acceleration: Vec3,
+    /// The change of linear velocity this step's applied forces (and damping) make over the
+    /// whole step (m/s), not yet in `linear_velocity`. A resolver adds it over the step as it
+    /// adds gravity: Millington at once before resolving, the soft step in equal parts per
+    /// substep, so that a force which static friction holds is answered within each substep
+    /// instead of moving the body between its substeps.
+    pub force_velocity: Vec3,
+    /// The change of angular velocity this step's applied torques (and damping) make over the
+    /// whole step (rad/s), added the same way.
+    pub torque_velocity: Vec3,
 }
 
-const _: () = assert!(size_of::<SolverBody>() <= 112);
+const _: () = assert!(size_of::<SolverBody>() <= 144);
 
 impl SolverBody {
     /// Flag: the body's inverse inertia is non-zero, so resolvers do angular work for it.
@@ -58,6 +67,8 @@ impl SolverBody {
         angular_velocity: Vec3::ZERO,
         inv_inertia: Mat3::ZERO,
         last_acceleration: Vec3::ZERO,
+        force_velocity: Vec3::ZERO,
+        torque_velocity: Vec3::ZERO,
     };
 
     /// A dynamic body at `position` with the given inverse mass and world inverse inertia,
@@ -73,6 +84,8 @@ impl SolverBody {
             angular_velocity: Vec3::ZERO,
             inv_inertia,
             last_acceleration: Vec3::ZERO,
+            force_velocity: Vec3::ZERO,
+            torque_velocity: Vec3::ZERO,
         }
     }
 

@@ -10,13 +10,20 @@ use super::body_state::{BodyState, PseudoRow};
 use super::gyroscopic::turn_against;
 use jostle_math::{Mat3, Quat, Vec3, integrate_orientation};
 
-/// v ← v + g·h for every body of `states` with mass; no angular change.
-pub fn integrate_velocities(states: &mut [BodyState], gravity: Vec3, h: f32) {
+/// v ← v + g·h for every body of `states` with mass, and each body's share of its applied
+/// forces, `pushes` (linear and angular velocity change per substep, parallel to `states`;
+/// empty when no body has any).
+pub fn integrate_velocities(states: &mut [BodyState], pushes: &[[Vec3; 2]], gravity: Vec3, h: f32) {
+    debug_assert!(pushes.is_empty() || pushes.len() == states.len());
     let dv = gravity * h;
     for s in states.iter_mut() {
         if s.inv_mass > 0.0 {
             s.linear_velocity += dv;
         }
+    }
+    for (s, [linear, angular]) in states.iter_mut().zip(pushes) {
+        s.linear_velocity += *linear;
+        s.angular_velocity += *angular;
     }
 }
 

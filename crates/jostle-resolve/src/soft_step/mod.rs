@@ -149,6 +149,9 @@ pub struct SoftStepResolver {
     /// The settings used by the next step; change them freely between steps.
     pub settings: SoftStepSettings,
     states: Vec<BodyState>,
+    /// Each body's share per substep of its applied forces' velocity change (linear,
+    /// angular; [`SolverBody::force_velocity`]); empty when no body has any.
+    pushes: Vec<[jostle_math::Vec3; 2]>,
     inertia: Vec<Mat3>,
     /// With the gyroscopic term: each body's step-start world inverse inertia if some contact
     /// of the step involves it, else zero (`gyroscopic::turn_against`).
@@ -265,6 +268,19 @@ impl SoftStepResolver {
     fn load_bodies(&mut self, bodies: &[SolverBody]) {
         self.states.clear();
         self.states.extend(bodies.iter().map(BodyState::from_body));
+        self.pushes.clear();
+        let zero = jostle_math::Vec3::ZERO;
+        if bodies
+            .iter()
+            .any(|b| b.force_velocity != zero || b.torque_velocity != zero)
+        {
+            let share = 1.0 / self.settings.substeps.max(1) as f32;
+            self.pushes.extend(
+                bodies
+                    .iter()
+                    .map(|b| [b.force_velocity * share, b.torque_velocity * share]),
+            );
+        }
         self.pseudo.clear();
         self.pseudo.resize(bodies.len(), [0.0; 8]);
         if let Some(s) = self.states.get_mut(STATIC_BODY as usize) {
@@ -347,8 +363,11 @@ impl SoftStepResolver {
             let energy = |v: jostle_math::Vec3, w: jostle_math::Vec3, i: Mat3| {
                 0.5 * mass * v.length_squared() + 0.5 * w.dot(i * w)
             };
-            let allowed = energy(start.linear_velocity, start.angular_velocity, inertia)
-                + mass * gravity.dot(state.delta_position);
+            let allowed = energy(
+                start.linear_velocity + start.force_velocity,
+                start.angular_velocity + start.torque_velocity,
+                inertia,
+            ) + mass * gravity.dot(state.delta_position);
             let now = energy(state.linear_velocity, state.angular_velocity, inertia_now);
             if now > allowed {
                 let scale = (allowed.max(0.0) / now).sqrt();
@@ -398,8 +417,11 @@ impl SoftStepResolver {
             let energy = |v: jostle_math::Vec3, w: jostle_math::Vec3, i: Mat3| {
                 0.5 * mass * v.length_squared() + 0.5 * w.dot(i * w)
             };
-            let allowed = energy(start.linear_velocity, start.angular_velocity, inertia)
-                + mass * gravity.dot(state.delta_position);
+            let allowed = energy(
+                start.linear_velocity + start.force_velocity,
+                start.angular_velocity + start.torque_velocity,
+                inertia,
+            ) + mass * gravity.dot(state.delta_position);
             let (dv, dw) = (state.linear_velocity - v_s, state.angular_velocity - w_s);
             let Some(s) = crate::energy::bounded_fraction(
                 mass,
@@ -575,6 +597,8 @@ struct Substeps<'a> {
     groups: &'a [u32],
     states: &'a [Shared<BodyState>],
     pseudo: &'a [Shared<PseudoRow>],
+    /// [`SoftStepResolver::pushes`].
+    pushes: &'a [[Vec3; 2]],
     inertia: &'a [Mat3],
     /// [`SoftStepResolver::rows_inverse`].
     rows_inverse: &'a [Mat3],
@@ -605,8 +629,12 @@ impl Substeps<'_> {
                 ..self.pass
             };
             timing.time(Timing::INTEGRATE, || {
-                self.each_body_range(crew, |states, _| {
-                    integrate::integrate_velocities(states, self.gravity, self.h);
+                self.each_body_range(crew, |states, first| {
+                    let pushes = self
+                        .pushes
+                        .get(first..first + states.len())
+                        .unwrap_or_default();
+                    integrate::integrate_velocities(states, pushes, self.gravity, self.h);
                 });
             });
             timing.time(Timing::SOLVE, || {
@@ -819,6 +847,7 @@ impl Resolver for SoftStepResolver {
                 groups,
                 states: share(&mut self.states),
                 pseudo: share(&mut self.pseudo),
+                pushes: &self.pushes,
                 inertia: &self.inertia,
                 rows_inverse: &self.rows_inverse,
                 gyroscopic: self.settings.gyroscopic,
