@@ -325,3 +325,25 @@ fn stiffness_table() {
         }
     }
 }
+
+/// `SoftStepSettings::block_relax` (an experiment, off by default): a column of 20 unit boxes
+/// started at rest stands 10 s with its top never more than 1 cm sideways of its start, as
+/// point by point (2.4 mm, against 5.0; benches/RESULTS.md, "Each manifold's normal rows
+/// solved together").
+#[test]
+fn block_relax_holds_a_column_of_20() {
+    let text = "Scene(sleep: (enabled: false), resolver: SoftStep(block_relax: true), bodies: [\
+        Body(name: \"ground\", shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true, friction: 0.6)], \
+        generators: [Stack(count: 20, friction: 0.6)])";
+    let scene = Scene::parse(text, "column.ron").unwrap();
+    let mut world = scene.build().unwrap();
+    let top = world.find_body("stack-19").unwrap();
+    let start = world.body(top).unwrap().position;
+    let mut furthest = 0.0f32;
+    for _ in 0..600 {
+        world.step(scene.dt).unwrap();
+        let p = world.body(top).unwrap().position;
+        furthest = furthest.max((p - start).with_y(0.0).length());
+    }
+    assert!(furthest < 0.01, "the top moved up to {furthest} m sideways");
+}

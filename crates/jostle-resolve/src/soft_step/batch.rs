@@ -130,7 +130,15 @@ pub struct ManifoldLanes<F = F8> {
     pub count: u32,
     /// Whether any point of any lane has friction (μ > 0): otherwise friction is skipped.
     pub friction: bool,
+    /// The Cholesky factor L of the batch's block system K + ε·diag(K) over its points
+    /// ([`super::solve::factor_blocks`], for the block relax): L's entries below the
+    /// diagonal row by row (l₁₀, l₂₀, l₂₁, l₃₀, l₃₁, l₃₂), then 1/lᵢᵢ for i = 0..4.
+    pub block: [F; BLOCK_ENTRIES],
 }
+
+/// Entries of [`ManifoldLanes::block`]: the six below the diagonal of a 4 × 4 factor and
+/// the four reciprocals of its diagonal.
+pub const BLOCK_ENTRIES: usize = 10;
 
 /// The prepared contacts of one step, packed for the kernels.
 #[derive(Clone, Debug, Default)]
@@ -403,6 +411,7 @@ impl Batches {
             first,
             count,
             friction,
+            block: [F8::ZERO; BLOCK_ENTRIES],
         });
     }
 

@@ -612,6 +612,8 @@ struct Substeps<'a> {
     relax_iterations: u32,
     pass: solve::BiasedPass,
     sweeps: u32,
+    /// [`SoftStepSettings::block_relax`] (soft contacts only).
+    block_relax: bool,
     /// Batches per stage item (`u32::MAX`: a whole group).
     batch_chunk: u32,
     /// Bodies per stage item (`u32::MAX`: all).
@@ -663,7 +665,8 @@ impl Substeps<'_> {
             timing.time(Timing::RELAX, || {
                 for _ in 0..self.relax_iterations {
                     self.each_batch_range(crew, |m, p, base| {
-                        solve::relax_range(m, p, base, self.states, self.inv_h, self.sweeps);
+                        let sweeps = if self.block_relax { 0 } else { self.sweeps };
+                        solve::relax_range(m, p, base, self.states, self.inv_h, sweeps);
                     });
                     self.direct_correct(crew, solve::RowPass::Relax { inv_h: self.inv_h });
                 }
@@ -773,6 +776,9 @@ impl Resolver for SoftStepResolver {
         self.load_bodies(bodies);
         let any_restitution = self.prepare_contacts(bodies, contacts, h, ctx.gravity.length());
         self.mark_contact_rows(bodies, contacts);
+        if self.settings.block_relax && !self.settings.rigid_contacts {
+            solve::factor_blocks(&mut self.batches);
+        }
         // Rigid contacts have their own push-out and no spring to size: no direct solve.
         let direct_rows = if self.settings.rigid_contacts {
             0
@@ -860,6 +866,7 @@ impl Resolver for SoftStepResolver {
                 relax_iterations: self.settings.relax_iterations,
                 pass,
                 sweeps,
+                block_relax: self.settings.block_relax && !rigid,
                 batch_chunk: if threads > 1 {
                     TEAM_BATCH_CHUNK
                 } else {

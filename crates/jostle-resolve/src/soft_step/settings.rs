@@ -82,6 +82,14 @@ pub struct SoftStepSettings {
     /// Start each step from the contact impulses of the previous step (matched by feature
     /// id). Default true. Without it stacks need many more substeps to stand.
     pub warm_start: bool,
+    /// Solve each manifold's normal rows together in the relax pass: one small linear system
+    /// per manifold (at most 4 × 4, regularised by a tenth of its diagonal, factored once per
+    /// step) instead of point after point. Default false: an experiment, measured and not the
+    /// default. On the stability family every one of the 42 cases meets the criterion with it
+    /// (the 60-box column sways 6.3 mm instead of 11.2), but a column of 15 started at rest
+    /// sways 13 cm within its first 2 s before it settles, and why it helps the columns is not
+    /// established (benches/RESULTS.md, "Each manifold's normal rows solved together").
+    pub block_relax: bool,
     /// Rigid contacts instead of springs. Default false.
     ///
     /// Soft contacts (`contact_hertz`, `static_hertz`) are springs: without load compensation
@@ -161,6 +169,7 @@ impl Default for SoftStepSettings {
             gyroscopic: true,
             friction_in_bias_pass: false,
             warm_start: true,
+            block_relax: false,
             rigid_contacts: false,
             rigid_slop: 0.001,
             push_out_rate: 0.2,

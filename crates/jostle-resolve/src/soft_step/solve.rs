@@ -18,7 +18,7 @@
 //! written. Every branch on a contact's state is a lane-wise select, so a lane's result does
 //! not depend on its neighbours.
 
-use super::batch::{Batches, LANES, MAX_POINTS, ManifoldLanes, PointLanes};
+use super::batch::{BLOCK_ENTRIES, Batches, LANES, MAX_POINTS, ManifoldLanes, PointLanes};
 use super::body_state::{BodyState, PseudoRow};
 use super::lanes::{F8, Lane, LaneMask, Q8, V3x8};
 use super::shared::{Shared, share};
@@ -601,6 +601,169 @@ fn relax_batch<F: Lane>(
     }
 }
 
+/// Relative regularisation of the block system of [`relax_block`]: K + ε·diag(K). A face's
+/// four rows span three motions, so K alone is singular, and the part of the right-hand side
+/// K cannot produce (the bias of a speculative corner, a face's points at slightly different
+/// depths) would be amplified by 1/ε. At 10⁻⁴, with each point's total clamped on its own,
+/// that made impulses of ±2,000 N·s on a resting 1,000 kg box and threw it up at 3.9 m/s; at
+/// 0.1 the block is an under-relaxed exact solve (each row reaches 1/1.1 of its target in one
+/// pass, the rest in the next substeps), with which every case of the stability family meets
+/// its criterion (benches/RESULTS.md, "Each manifold's normal rows solved together").
+const BLOCK_REGULARISATION: f32 = 0.1;
+
+/// The index in [`ManifoldLanes::block`] of L's entry (i, j), i > j.
+#[inline(always)]
+const fn below(i: usize, j: usize) -> usize {
+    i * (i - 1) / 2 + j
+}
+
+/// Factors each batch's block system for [`relax_block`], once per step: K = J·M⁻¹·Jᵀ over
+/// the batch's points (lane by lane), plus ε·diag(K) ([`BLOCK_REGULARISATION`]), as L·Lᵀ into
+/// [`ManifoldLanes::block`]. A padding point (no row) gets an identity row. The Jacobians and
+/// masses are the step's, fixed through its substeps.
+pub fn factor_blocks(batches: &mut Batches) {
+    let Batches {
+        manifolds, points, ..
+    } = batches;
+    for m in manifolds.iter_mut() {
+        let first = m.first as usize;
+        let pts = &points[first..first + m.count as usize];
+        m.block = factor_block::<F8>(m, pts);
+    }
+}
+
+// Index loops: the factorisation reads L by row and column, as the formulas do.
+#[allow(clippy::needless_range_loop)]
+#[inline(always)]
+fn factor_block<F: Lane>(m: &ManifoldLanes<F>, points: &[PointLanes<F>]) -> [F; BLOCK_ENTRIES] {
+    let n = points.len().min(MAX_POINTS);
+    let zero = V3x8 {
+        x: F::ZERO,
+        y: F::ZERO,
+        z: F::ZERO,
+    };
+    let mut rn_a = [zero; MAX_POINTS];
+    let mut rn_b = [zero; MAX_POINTS];
+    for (i, p) in points.iter().take(n).enumerate() {
+        rn_a[i] = p.r_a.cross(p.normal);
+        rn_b[i] = p.r_b.cross(p.normal);
+    }
+    let m_sum = m.inv_mass_a + m.inv_mass_b;
+    let mut k = [[F::ZERO; MAX_POINTS]; MAX_POINTS];
+    for i in 0..n {
+        for j in 0..=i {
+            let (pi, pj) = (&points[i], &points[j]);
+            let kij = pi.normal.dot(pj.normal) * m_sum
+                + rn_a[i].dot(pj.ang_a_normal)
+                + rn_b[i].dot(pj.ang_b_normal);
+            k[i][j] = kij;
+            k[j][i] = kij;
+        }
+    }
+    for (i, p) in points.iter().take(n).enumerate() {
+        let live = p.normal_mass.cmpgt(F::ZERO);
+        k[i][i] = F::select(live, k[i][i] * F::splat(1.0 + BLOCK_REGULARISATION), F::ONE);
+    }
+    let mut block = [F::ZERO; BLOCK_ENTRIES];
+    let mut l = [[F::ZERO; MAX_POINTS]; MAX_POINTS];
+    for j in 0..n {
+        let mut d = k[j][j];
+        for q in 0..j {
+            d = d - l[j][q] * l[j][q];
+        }
+        let root = d.max(F::splat(f32::MIN_POSITIVE)).sqrt();
+        l[j][j] = root;
+        let inv = root.recip();
+        block[6 + j] = inv;
+        for i in j + 1..n {
+            let mut s = k[i][j];
+            for q in 0..j {
+                s = s - l[i][q] * l[j][q];
+            }
+            l[i][j] = s * inv;
+            block[below(i, j)] = l[i][j];
+        }
+    }
+    block
+}
+
+/// The relax pass over one batch with each manifold's normal rows solved together: the
+/// impulses x of all its points at once from (K + ε·diag K)·x = −(vₙ + bias), K = J·M⁻¹·Jᵀ
+/// over the manifold's points (factored once per step, [`factor_blocks`]), then each point's
+/// friction in order ([`super::SoftStepSettings::block_relax`], an experiment).
+#[allow(clippy::needless_range_loop)]
+#[inline(always)]
+fn relax_block<F: Lane>(
+    m: &ManifoldLanes<F>,
+    pair: &mut Pair<F>,
+    points: &mut [PointLanes<F>],
+    states: &[Shared<BodyState>],
+    inv_h: F,
+) {
+    store_separations(m, points, states);
+    let n = points.len().min(MAX_POINTS);
+    let mut b = [F::ZERO; MAX_POINTS];
+    // The block serves lanes with two or more points (a single point's row is exact point by
+    // point, and the regularisation would only under-relax it). A speculative point keeps its
+    // gap rule in the block: its bias s/h, which K need not be able to produce; excluding such
+    // lanes instead (solved point by point) let the column of 10 m boxes sway 1.4 m.
+    for (i, p) in points.iter().take(n).enumerate() {
+        let live = p.normal_mass.cmpgt(F::ZERO);
+        // A padding point's row is zero: its right-hand side too.
+        let bias = F::select(p.separation.cmpgt(F::ZERO), p.separation * inv_h, F::ZERO);
+        b[i] = F::select(
+            live,
+            pair.relative_velocity(p).dot(p.normal) + bias,
+            F::ZERO,
+        );
+    }
+    let single = match points.get(1) {
+        Some(p) => p.normal_mass.cmple(F::ZERO),
+        None => F::ZERO.cmple(F::ZERO),
+    };
+    // L·y = −b, then Lᵀ·x = y.
+    let l = &m.block;
+    let mut y = [F::ZERO; MAX_POINTS];
+    for i in 0..n {
+        let mut s = F::ZERO - b[i];
+        for q in 0..i {
+            s = s - l[below(i, q)] * y[q];
+        }
+        y[i] = s * l[6 + i];
+    }
+    let mut x = [F::ZERO; MAX_POINTS];
+    for i in (0..n).rev() {
+        let mut s = y[i];
+        for q in i + 1..n {
+            s = s - l[below(q, i)] * x[q];
+        }
+        x[i] = s * l[6 + i];
+    }
+    // Where every point's total stays a push, the block's impulses; in a lane where one
+    // would pull, none of them: clamping that point alone would turn the opposite impulses of
+    // a face's twist (which the system leaves nearly free) into a net push. Such lanes are
+    // solved point after point instead.
+    // `pulls` marks the lanes solved point by point: a lane the block does not serve, or one
+    // where some point's total would pull.
+    let mut pulls = single;
+    for (p, &dx) in points.iter().zip(&x).take(n) {
+        pulls = pulls | (p.normal_impulse + dx).cmplt(F::ZERO);
+    }
+    for (p, &dx) in points.iter_mut().zip(&x).take(n) {
+        accumulate_normal(pair, p, F::select(pulls, F::ZERO, dx));
+    }
+    let fallback = pulls.any();
+    for p in points.iter_mut() {
+        if fallback {
+            let gs = rigid_row(pair, p, p.separation, inv_h);
+            accumulate_normal(pair, p, F::select(pulls, gs, F::ZERO));
+        }
+        if m.friction {
+            solve_friction(pair, p);
+        }
+    }
+}
+
 /// One point of a single relax sweep: its normal row, then its friction.
 #[inline(always)]
 fn relax_point<F: Lane>(m: &ManifoldLanes<F>, pair: &mut Pair<F>, p: &mut PointLanes<F>, inv_h: F) {
@@ -915,6 +1078,20 @@ fn relax_impl<F: Lane>(
     sweeps: u32,
 ) {
     let mut rest = manifolds;
+    if sweeps == 0 {
+        // Block relax (`SoftStepSettings::block_relax`).
+        let inv_h_lanes = F::splat(inv_h);
+        for_each_batch!(
+            manifolds,
+            points,
+            base,
+            states,
+            |m, pair, points, states| {
+                relax_block(m, pair, points, states, inv_h_lanes);
+            }
+        );
+        return;
+    }
     if sweeps == 1 {
         // Two batches at a time, their points interleaved: each point's rows depend on the
         // velocities the point before left, so one batch is a single chain of dependent
@@ -986,6 +1163,7 @@ fn two_batches<'a, F>(
 /// rule); `sweeps` > 1 sweeps each manifold's normal rows that often before its friction
 /// (rigid contacts).
 pub fn relax(batches: &mut Batches, states: &mut [BodyState], inv_h: f32, sweeps: u32) {
+    debug_assert!(sweeps > 0);
     let states = share(states);
     by_group(batches, |m, p, base| {
         relax_range(m, p, base, states, inv_h, sweeps)
