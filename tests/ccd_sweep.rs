@@ -17,33 +17,14 @@
 //! every shot that fails (benches/RESULTS.md, "CCD: no freeze, no tunnel").
 
 use jostle::{BodyDesc, BodyHandle, Quat, ResolverChoice, ShapeDesc, Vec3, World, WorldSettings};
-use proptest::prelude::Rng as _;
-use proptest::test_runner::{RngAlgorithm, TestRng};
+mod common;
 
 const DT: f32 = 1.0 / 60.0;
 const STEPS: usize = 240;
 /// Shots per resolver in the CI part.
 const SHOTS: u64 = 48;
 
-/// proptest's seeded generator, so every run sees the same shots.
-struct Rng(TestRng);
-
-impl Rng {
-    fn new(seed: u64) -> Self {
-        let mut bytes = [0u8; 32];
-        bytes[..8].copy_from_slice(&seed.to_le_bytes());
-        Self(TestRng::from_seed(RngAlgorithm::ChaCha, &bytes))
-    }
-
-    /// Uniform in [lo, hi).
-    fn uniform(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * ((self.0.next_u64() >> 40) as f32 / (1u64 << 24) as f32)
-    }
-
-    fn pick<T: Copy>(&mut self, items: &[T]) -> T {
-        items[(self.0.next_u64() % items.len() as u64) as usize]
-    }
-}
+use common::SeededRng as Rng;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Projectile {

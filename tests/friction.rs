@@ -4,23 +4,16 @@
 //! coefficient (`BodyDesc::with_dynamic_friction`, scene field `dynamic_friction`) defaults to
 //! the static one, so every scene keeps its meaning.
 
+mod common;
+
+use common::resolvers;
 use jostle::scene::Scene;
-use jostle::{
-    BodyDesc, BodyHandle, MillingtonSettings, ResolverChoice, ShapeDesc, SoftStepSettings, Vec3,
-    World, WorldSettings,
-};
+use jostle::{BodyDesc, BodyHandle, ResolverChoice, ShapeDesc, Vec3, World, WorldSettings};
 
 const G: f32 = 9.81;
 const DT: f32 = 1.0 / 60.0;
 const STATIC: f32 = 0.8;
 const DYNAMIC: f32 = 0.4;
-
-fn resolvers() -> [ResolverChoice; 2] {
-    [
-        ResolverChoice::SoftStep(SoftStepSettings::default()),
-        ResolverChoice::Millington(MillingtonSettings::default()),
-    ]
-}
 
 /// A 1 m cube of `mass` kg resting on the ground, both with μs 0.8 and μd 0.4, moving at
 /// `speed` along x; sleeping off.

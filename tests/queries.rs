@@ -5,24 +5,9 @@
 use jostle::{
     BodyDesc, BodyHandle, Pose, Quat, QueryFilter, ShapeDesc, Vec3, World, WorldSettings,
 };
-use proptest::prelude::Rng as _;
-use proptest::test_runner::{RngAlgorithm, TestRng};
+mod common;
 
-/// proptest's seeded generator, so every run sees the same scenes and queries.
-struct Rng(TestRng);
-
-impl Rng {
-    fn new(seed: u64) -> Self {
-        let mut bytes = [0u8; 32];
-        bytes[..8].copy_from_slice(&seed.to_le_bytes());
-        Self(TestRng::from_seed(RngAlgorithm::ChaCha, &bytes))
-    }
-
-    /// Uniform in the range.
-    fn random_range(&mut self, r: std::ops::Range<f32>) -> f32 {
-        r.start + (r.end - r.start) * ((self.0.next_u64() >> 40) as f32 / (1u64 << 24) as f32)
-    }
-}
+use common::SeededRng as Rng;
 
 /// A ground and `n` mixed bodies dropped onto it in a loose pile, stepped `steps` times so
 /// that some move, some rest and some sleep.
@@ -47,31 +32,31 @@ fn pile(n: usize, steps: usize, seed: u64) -> World {
     for i in 0..n {
         let shape = match i % 4 {
             0 => ShapeDesc::Ball {
-                radius: rng.random_range(0.1..0.6),
+                radius: rng.uniform(0.1, 0.6),
             },
             1 => ShapeDesc::Cuboid {
                 half_extents: Vec3::new(
-                    rng.random_range(0.1..0.6),
-                    rng.random_range(0.1..0.6),
-                    rng.random_range(0.1..0.6),
+                    rng.uniform(0.1, 0.6),
+                    rng.uniform(0.1, 0.6),
+                    rng.uniform(0.1, 0.6),
                 ),
             },
             2 => ShapeDesc::Capsule {
-                half_height: rng.random_range(0.1..0.5),
-                radius: rng.random_range(0.1..0.4),
+                half_height: rng.uniform(0.1, 0.5),
+                radius: rng.uniform(0.1, 0.4),
             },
             _ => ShapeDesc::Cylinder {
-                half_height: rng.random_range(0.1..0.5),
-                radius: rng.random_range(0.1..0.4),
+                half_height: rng.uniform(0.1, 0.5),
+                radius: rng.uniform(0.1, 0.4),
             },
         };
         let at = Vec3::new(
-            rng.random_range(-5.0..5.0),
-            rng.random_range(0.5..8.0),
-            rng.random_range(-5.0..5.0),
+            rng.uniform(-5.0, 5.0),
+            rng.uniform(0.5, 8.0),
+            rng.uniform(-5.0, 5.0),
         );
-        let turn = Quat::from_rotation_y(rng.random_range(0.0..6.0))
-            * Quat::from_rotation_x(rng.random_range(0.0..1.0));
+        let turn = Quat::from_rotation_y(rng.uniform(0.0, 6.0))
+            * Quat::from_rotation_x(rng.uniform(0.0, 1.0));
         w.add_body(
             BodyDesc::dynamic(format!("b{i}"), shape)
                 .at(at)
@@ -110,20 +95,20 @@ fn all_answers(w: &World, rng: &mut Rng, player: BodyHandle) -> Vec<String> {
     for k in 0..60 {
         let f = &filters[k % filters.len()];
         let origin = Vec3::new(
-            rng.random_range(-7.0..7.0),
-            rng.random_range(-1.0..9.0),
-            rng.random_range(-7.0..7.0),
+            rng.uniform(-7.0, 7.0),
+            rng.uniform(-1.0, 9.0),
+            rng.uniform(-7.0, 7.0),
         );
         let dir = Vec3::new(
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
+            rng.uniform(-1.0, 1.0),
+            rng.uniform(-1.0, 1.0),
+            rng.uniform(-1.0, 1.0),
         );
-        let reach = rng.random_range(0.0..20.0);
+        let reach = rng.uniform(0.0, 20.0);
         out.push(format!("ray {:?}", q.ray_cast(origin, dir, reach, f)));
         out.push(format!("all {:?}", q.ray_cast_all(origin, dir, reach, f)));
         out.push(format!("point {:?}", q.project_point(origin, reach, f)));
-        let pose = Pose::from_parts(origin, Quat::from_rotation_z(rng.random_range(0.0..3.0)));
+        let pose = Pose::from_parts(origin, Quat::from_rotation_z(rng.uniform(0.0, 3.0)));
         let shape = if k % 2 == 0 { &ball } else { &brick };
         out.push(format!("overlap {:?}", q.intersect_shape(shape, pose, f)));
         out.push(format!(
@@ -146,11 +131,11 @@ fn the_tree_and_the_brute_force_give_the_same_answers() {
         for i in (1..150).step_by(10) {
             let b = w.find_body(&format!("b{i}")).unwrap();
             let at = Vec3::new(
-                rng.random_range(-7.0..7.0),
-                rng.random_range(0.0..8.0),
-                rng.random_range(-7.0..7.0),
+                rng.uniform(-7.0, 7.0),
+                rng.uniform(0.0, 8.0),
+                rng.uniform(-7.0, 7.0),
             );
-            w.set_pose(b, at, Quat::from_rotation_y(rng.random_range(0.0..6.0)))
+            w.set_pose(b, at, Quat::from_rotation_y(rng.uniform(0.0, 6.0)))
                 .unwrap();
         }
         // Stepped and changed since the tree was last updated: brute force.

@@ -86,3 +86,30 @@ pub fn momentum(world: &World) -> Vec3 {
         .map(|(_, _, b)| b.linear_velocity * b.mass())
         .sum()
 }
+
+/// proptest's seeded generator (ChaCha), so that every run of a test sees the same draws.
+pub struct SeededRng(proptest::test_runner::TestRng);
+
+impl SeededRng {
+    /// The generator of `seed`.
+    pub fn new(seed: u64) -> Self {
+        let mut bytes = [0u8; 32];
+        bytes[..8].copy_from_slice(&seed.to_le_bytes());
+        Self(proptest::test_runner::TestRng::from_seed(
+            proptest::test_runner::RngAlgorithm::ChaCha,
+            &bytes,
+        ))
+    }
+
+    /// Uniform in [lo, hi).
+    pub fn uniform(&mut self, lo: f32, hi: f32) -> f32 {
+        use proptest::prelude::Rng as _;
+        lo + (hi - lo) * ((self.0.next_u64() >> 40) as f32 / (1u64 << 24) as f32)
+    }
+
+    /// One of `items`, uniformly.
+    pub fn pick<T: Copy>(&mut self, items: &[T]) -> T {
+        use proptest::prelude::Rng as _;
+        items[(self.0.next_u64() % items.len() as u64) as usize]
+    }
+}
