@@ -361,7 +361,7 @@ fn validation_errors_name_the_line_and_column_of_the_field() {
     let text = "Scene(name: \"s\",\n  bodies: [\n    Body(name: \"a\", shape: Ball(radius: 0.5)),\n    Body(name: \"b\", shape: Ball(radius: 0.5),\n         mass: -1.0),\n  ])\n";
     let e = error(text).to_string();
     assert!(
-        e.starts_with("bad.ron:5:10: body \"b\": field `mass`"),
+        e.starts_with("bad.ron:5:10: bodies[1]: body \"b\": field `mass`"),
         "{e}"
     );
     // A repeated name at the body that repeats it.
@@ -399,4 +399,23 @@ fn a_shape_too_small_for_f32_names_its_size_field() {
     let e = scene.build().err().expect("refused").to_string();
     assert!(e.contains("body \"t\": field `shape.radius`"), "{e}");
     assert!(e.contains("no usable mass"), "{e}");
+}
+
+#[test]
+fn a_body_without_a_name_is_named_by_its_place_in_the_list() {
+    let text = "Scene(bodies: [\n    Body(shape: Ball(radius: 0.5)),\n    Body(shape: Ball(radius: 0.5), friction: -1.0),\n])";
+    let e = error(text);
+    match &e {
+        SceneError::Body {
+            index: Some(1),
+            at: Some((3, 36)),
+            ..
+        } => {}
+        other => panic!("expected bodies[1] at 3:36, got {other:?}"),
+    }
+    let message = e.to_string();
+    assert!(
+        message.starts_with("bad.ron:3:36: bodies[1]: ") && message.contains("`friction`"),
+        "{message}"
+    );
 }

@@ -29,13 +29,16 @@ pub enum SceneError {
         body: Option<String>,
     },
     /// A body is invalid.
-    #[error("{file}{}: {error}", location(at))]
+    #[error("{file}{}: {}{error}", location(at), entry(index))]
     Body {
         /// The file.
         file: String,
         /// Line and column (from 1) of the field in the file, or of the body when the field is
         /// not written there; `None` for scenes not parsed from text or a body not found in it.
         at: Option<(usize, usize)>,
+        /// The body's place in the scene's `bodies` list (from 0), for a body written there:
+        /// what names a body without a name. `None` for a generated body.
+        index: Option<usize>,
         /// Which body and field.
         error: BodyError,
     },
@@ -58,7 +61,9 @@ impl SceneError {
     /// line and column of the field (or body) when the text shows where it is.
     pub(crate) fn in_file(self, name: &str, text: &str) -> Self {
         match self {
-            Self::Body { error, at, .. } => {
+            Self::Body {
+                error, at, index, ..
+            } => {
                 let BodyError::Field {
                     body,
                     field,
@@ -66,10 +71,18 @@ impl SceneError {
                 } = &error;
                 // A repeated name is reported at its later occurrence.
                 let last = field == "name" && message.contains("the same name");
-                let at = at.or_else(|| locate_body_field(text, body, field, last));
+                // A body without a name is found by its place in the list.
+                let by_index = || index.and_then(|i| locate_listed_body_field(text, i, field));
+                let at = if body.is_empty() {
+                    at.or_else(by_index)
+                } else {
+                    at.or_else(|| locate_body_field(text, body, field, last))
+                        .or_else(by_index)
+                };
                 Self::Body {
                     file: name.into(),
                     at,
+                    index,
                     error,
                 }
             }
@@ -126,6 +139,41 @@ fn enclosing_body(text: &str, line: usize, column: usize) -> Option<String> {
 }
 
 /// `:line:column` of a location, or nothing.
+/// `bodies[i]: ` for a body of the scene's list, so that a body without a name is named too.
+fn entry(index: &Option<usize>) -> String {
+    index.map(|i| format!("bodies[{i}]: ")).unwrap_or_default()
+}
+
+/// Where the `index`-th `Body(...)` of the `bodies` list writes `field` (or where that body
+/// starts, when it does not write the field).
+fn locate_listed_body_field(text: &str, index: usize, field: &str) -> Option<(usize, usize)> {
+    let mut search = find_key(text, 0, text.len(), "bodies")?;
+    let mut open = search;
+    for _ in 0..=index {
+        open = search + text[search..].find("Body(")?;
+        search = open + "Body(".len();
+    }
+    let start = open + "Body".len();
+    let mut depth = 0i32;
+    let mut end = text.len();
+    for (i, ch) in text[start..].char_indices() {
+        depth += match ch {
+            '(' => 1,
+            ')' => -1,
+            _ => 0,
+        };
+        if depth == 0 {
+            end = start + i;
+            break;
+        }
+    }
+    let key = field.rsplit('.').next().unwrap_or(field);
+    Some(line_column(
+        text,
+        find_key(text, start, end, key).unwrap_or(open),
+    ))
+}
+
 fn location(at: &Option<(usize, usize)>) -> String {
     at.map(|(line, column)| format!(":{line}:{column}"))
         .unwrap_or_default()

@@ -345,10 +345,11 @@ impl Scene {
                 .map_err(|(field, message)| setting(&format!("resolver.{field}"), message))?,
             None => {}
         }
-        for body in &self.bodies {
+        for (i, body) in self.bodies.iter().enumerate() {
             body.to_desc().map_err(|e| SceneError::Body {
                 file: String::new(),
                 at: None,
+                index: Some(i),
                 error: e,
             })?;
         }
@@ -403,10 +404,11 @@ impl Scene {
     /// Every body of the scene, generated ones last.
     pub fn body_descs(&self) -> Result<Vec<BodyDesc>, SceneError> {
         let mut out = Vec::with_capacity(self.bodies.len());
-        for b in &self.bodies {
+        for (i, b) in self.bodies.iter().enumerate() {
             out.push(b.to_desc().map_err(|e| SceneError::Body {
                 file: String::new(),
                 at: None,
+                index: Some(i),
                 error: e,
             })?);
         }
@@ -425,10 +427,11 @@ impl Scene {
     /// Builds the world with the scene's settings (overridden by `settings` when given).
     pub fn build_with(&self, settings: WorldSettings) -> Result<World, SceneError> {
         let mut world = World::new(settings);
-        for desc in self.body_descs()? {
+        for (i, desc) in self.body_descs()?.into_iter().enumerate() {
             world.add_body(desc).map_err(|e| SceneError::Body {
                 file: String::new(),
                 at: None,
+                index: (i < self.bodies.len()).then_some(i),
                 error: e,
             })?;
         }
@@ -450,6 +453,7 @@ fn unique_names(names: &[&str]) -> Result<(), SceneError> {
             return Err(SceneError::Body {
                 file: String::new(),
                 at: None,
+                index: None,
                 error: BodyError::Field {
                     body: name.to_string(),
                     field: "name".into(),
