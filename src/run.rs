@@ -257,12 +257,19 @@ pub enum LoadError {
     /// The file could not be read.
     #[error("{0}")]
     Io(String),
-    /// A bad scene.
+    /// A bad scene (boxed: a scene error carries the file, the place and the message).
     #[error(transparent)]
-    Scene(#[from] crate::scene::SceneError),
+    Scene(Box<crate::scene::SceneError>),
     /// A bad snapshot.
     #[error(transparent)]
     Snapshot(#[from] crate::snapshot::SnapshotError),
+}
+
+#[cfg(feature = "scene")]
+impl From<crate::scene::SceneError> for LoadError {
+    fn from(e: crate::scene::SceneError) -> Self {
+        Self::Scene(Box::new(e))
+    }
 }
 
 #[cfg(all(test, feature = "scene"))]

@@ -35,10 +35,10 @@ pub enum SceneError {
         file: String,
         /// Line and column (from 1) of the field in the file, or of the body when the field is
         /// not written there; `None` for scenes not parsed from text or a body not found in it.
-        at: Option<(usize, usize)>,
+        at: Option<(u32, u32)>,
         /// The body's place in the scene's `bodies` list (from 0), for a body written there:
         /// what names a body without a name. `None` for a generated body.
-        index: Option<usize>,
+        index: Option<u32>,
         /// Which body and field.
         error: BodyError,
     },
@@ -48,7 +48,7 @@ pub enum SceneError {
         /// The file.
         file: String,
         /// Line and column (from 1) of the field in the file, when it is written there.
-        at: Option<(usize, usize)>,
+        at: Option<(u32, u32)>,
         /// The field.
         field: String,
         /// What is wrong.
@@ -72,11 +72,15 @@ impl SceneError {
                 // A repeated name is reported at its later occurrence.
                 let last = field == "name" && message.contains("the same name");
                 // A body without a name is found by its place in the list.
-                let by_index = || index.and_then(|i| locate_listed_body_field(text, i, field));
+                let by_index = || {
+                    index
+                        .and_then(|i| locate_listed_body_field(text, i as usize, field))
+                        .map(narrow)
+                };
                 let at = if body.is_empty() {
                     at.or_else(by_index)
                 } else {
-                    at.or_else(|| locate_body_field(text, body, field, last))
+                    at.or_else(|| locate_body_field(text, body, field, last).map(narrow))
                         .or_else(by_index)
                 };
                 Self::Body {
@@ -90,7 +94,7 @@ impl SceneError {
                 field, message, at, ..
             } => Self::Setting {
                 file: name.into(),
-                at: at.or_else(|| locate_setting(text, &field)),
+                at: at.or_else(|| locate_setting(text, &field).map(narrow)),
                 field,
                 message,
             },
@@ -139,8 +143,15 @@ fn enclosing_body(text: &str, line: usize, column: usize) -> Option<String> {
 }
 
 /// `:line:column` of a location, or nothing.
+/// A line and column as stored in an error (a file of more than 4·10⁹ lines or columns
+/// saturates).
+fn narrow((line, column): (usize, usize)) -> (u32, u32) {
+    let n = |x: usize| u32::try_from(x).unwrap_or(u32::MAX);
+    (n(line), n(column))
+}
+
 /// `bodies[i]: ` for a body of the scene's list, so that a body without a name is named too.
-fn entry(index: &Option<usize>) -> String {
+fn entry(index: &Option<u32>) -> String {
     index.map(|i| format!("bodies[{i}]: ")).unwrap_or_default()
 }
 
@@ -174,7 +185,7 @@ fn locate_listed_body_field(text: &str, index: usize, field: &str) -> Option<(us
     ))
 }
 
-fn location(at: &Option<(usize, usize)>) -> String {
+fn location(at: &Option<(u32, u32)>) -> String {
     at.map(|(line, column)| format!(":{line}:{column}"))
         .unwrap_or_default()
 }

@@ -349,7 +349,7 @@ impl Scene {
             body.to_desc().map_err(|e| SceneError::Body {
                 file: String::new(),
                 at: None,
-                index: Some(i),
+                index: Some(i as u32),
                 error: e,
             })?;
         }
@@ -408,7 +408,7 @@ impl Scene {
             out.push(b.to_desc().map_err(|e| SceneError::Body {
                 file: String::new(),
                 at: None,
-                index: Some(i),
+                index: Some(i as u32),
                 error: e,
             })?);
         }
@@ -431,7 +431,7 @@ impl Scene {
             world.add_body(desc).map_err(|e| SceneError::Body {
                 file: String::new(),
                 at: None,
-                index: (i < self.bodies.len()).then_some(i),
+                index: (i < self.bodies.len()).then_some(i as u32),
                 error: e,
             })?;
         }
