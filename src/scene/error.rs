@@ -143,6 +143,24 @@ fn enclosing_body(text: &str, line: usize, column: usize) -> Option<String> {
 }
 
 /// `:line:column` of a location, or nothing.
+/// The byte range of a `Body(...)` whose `Body(` starts at `open`: from its `(` to the
+/// matching `)` (or the end of the text).
+fn body_span(text: &str, open: usize) -> (usize, usize) {
+    let start = open + "Body".len();
+    let mut depth = 0i32;
+    for (i, ch) in text[start..].char_indices() {
+        depth += match ch {
+            '(' => 1,
+            ')' => -1,
+            _ => 0,
+        };
+        if depth == 0 {
+            return (start, start + i);
+        }
+    }
+    (start, text.len())
+}
+
 /// A line and column as stored in an error (a file of more than 4·10⁹ lines or columns
 /// saturates).
 fn narrow((line, column): (usize, usize)) -> (u32, u32) {
@@ -164,20 +182,7 @@ fn locate_listed_body_field(text: &str, index: usize, field: &str) -> Option<(us
         open = search + text[search..].find("Body(")?;
         search = open + "Body(".len();
     }
-    let start = open + "Body".len();
-    let mut depth = 0i32;
-    let mut end = text.len();
-    for (i, ch) in text[start..].char_indices() {
-        depth += match ch {
-            '(' => 1,
-            ')' => -1,
-            _ => 0,
-        };
-        if depth == 0 {
-            end = start + i;
-            break;
-        }
-    }
+    let (start, end) = body_span(text, open);
     let key = field.rsplit('.').next().unwrap_or(field);
     Some(line_column(
         text,
@@ -241,20 +246,7 @@ fn locate_body_field(text: &str, body: &str, field: &str, last: bool) -> Option<
         let Some(open) = text[..at].rfind("Body(") else {
             continue;
         };
-        let start = open + 4;
-        let mut depth = 0i32;
-        let mut end = text.len();
-        for (i, ch) in text[start..].char_indices() {
-            depth += match ch {
-                '(' => 1,
-                ')' => -1,
-                _ => 0,
-            };
-            if depth == 0 {
-                end = start + i;
-                break;
-            }
-        }
+        let (start, end) = body_span(text, open);
         found.push((at, find_key(text, start, end, key)));
     }
     // A repeated name: its later body. Otherwise the first body of that name that writes the

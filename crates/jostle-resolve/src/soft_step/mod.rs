@@ -363,11 +363,7 @@ impl SoftStepResolver {
             let energy = |v: jostle_math::Vec3, w: jostle_math::Vec3, i: Mat3| {
                 0.5 * mass * v.length_squared() + 0.5 * w.dot(i * w)
             };
-            let allowed = energy(
-                start.linear_velocity + start.force_velocity,
-                start.angular_velocity + start.torque_velocity,
-                inertia,
-            ) + mass * gravity.dot(state.delta_position);
+            let allowed = allowed_energy(start, inertia, state.delta_position, gravity);
             let now = energy(state.linear_velocity, state.angular_velocity, inertia_now);
             if now > allowed {
                 let scale = (allowed.max(0.0) / now).sqrt();
@@ -414,14 +410,7 @@ impl SoftStepResolver {
                 Mat3::ZERO
             };
             let inertia_now = gyroscopic::rotate_inertia(inertia, state.delta_rotation);
-            let energy = |v: jostle_math::Vec3, w: jostle_math::Vec3, i: Mat3| {
-                0.5 * mass * v.length_squared() + 0.5 * w.dot(i * w)
-            };
-            let allowed = energy(
-                start.linear_velocity + start.force_velocity,
-                start.angular_velocity + start.torque_velocity,
-                inertia,
-            ) + mass * gravity.dot(state.delta_position);
+            let allowed = allowed_energy(start, inertia, state.delta_position, gravity);
             let (dv, dw) = (state.linear_velocity - v_s, state.angular_velocity - w_s);
             let Some(s) = crate::energy::bounded_fraction(
                 mass,
@@ -749,6 +738,24 @@ impl Substeps<'_> {
             },
         );
     }
+}
+
+/// The mechanical energy a body of step-start state `start` (world inertia `inertia`) may end
+/// the step with when only immovable bodies touched it: its kinetic energy at the start, with
+/// the step's applied forces' velocity change ([`SolverBody::force_velocity`]) added, plus
+/// what gravity did over its displacement `moved`.
+fn allowed_energy(
+    start: &SolverBody,
+    inertia: Mat3,
+    moved: jostle_math::Vec3,
+    gravity: jostle_math::Vec3,
+) -> f32 {
+    let mass = 1.0 / start.inv_mass;
+    let (v, w) = (
+        start.linear_velocity + start.force_velocity,
+        start.angular_velocity + start.torque_velocity,
+    );
+    0.5 * mass * v.length_squared() + 0.5 * w.dot(inertia * w) + mass * gravity.dot(moved)
 }
 
 impl Resolver for SoftStepResolver {
