@@ -79,8 +79,8 @@ pub struct World {
     pub(crate) time: f64,
     pub(crate) steps: u64,
     scratch: Scratch,
-    /// Counts the changes that can move or add a collider (steps, added bodies, every mutable
-    /// access to a body); the broad phase's tree serves queries while `query_stamp` equals it.
+    /// Counts the changes that can move or add a collider (steps, added bodies, poses set);
+    /// the broad phase's tree serves queries while `query_stamp` equals it.
     stamp: u64,
     query_stamp: u64,
 }
@@ -239,7 +239,6 @@ impl World {
         if !self.bodies.contains(handle) {
             return Err(StepError::InvalidHandle(handle));
         }
-        self.stamp += 1;
         self.islands
             .wake(&mut self.bodies, handle, &self.settings.sleep);
         self.bodies
@@ -351,6 +350,7 @@ impl World {
         body.position = position;
         body.orientation = unit;
         body.update_world_inertia();
+        self.stamp += 1;
         Ok(())
     }
 
@@ -469,7 +469,7 @@ impl World {
     /// The scene queries at the bodies' current poses: rays (first hit and all hits), shape
     /// casts, point projection and shape overlap, each with a [`QueryFilter`].
     ///
-    /// After [`World::update_queries`], and until the next step or change to a body, they run
+    /// After [`World::update_queries`], and until the next step, added body or pose set, they run
     /// through the broad phase's tree: a ray among 10,000 colliders costs about what it costs
     /// among 100 (`cargo bench --bench queries`). Otherwise every collider is tested: the same
     /// results, at a cost that grows with the collider count. So call `update_queries` once
@@ -500,7 +500,7 @@ impl World {
     }
 
     /// Brings the broad phase's tree up to the bodies' current poses, so that
-    /// [`World::queries`] run through it until the next step or change to a body. Costs about
+    /// [`World::queries`] run through it until the next step, added body or pose set. Costs about
     /// what the broad phase's own pose check costs at the start of a step (one comparison per
     /// collider, a tree update per collider that moved out of its box); changes no result of
     /// any later step (tested).
@@ -512,7 +512,7 @@ impl World {
     }
 
     /// Whether [`World::queries`] run through the tree now ([`World::update_queries`] was
-    /// called since the last step or change to a body).
+    /// called since the last step, added body or pose set).
     pub fn queries_use_tree(&self) -> bool {
         self.query_stamp == self.stamp
     }

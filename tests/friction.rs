@@ -1,6 +1,7 @@
-//! Static and dynamic friction, against their closed forms, in both resolvers: a box sliding on
-//! the ground decelerates at μd·g, one pushed with a force between μd·m·g and μs·m·g from rest
-//! stays put, and one pushed harder accelerates at F/m − μd·g. The materials' dynamic
+//! Static and dynamic friction, against their closed forms, in both resolvers, for cubes of
+//! 0.1, 1 and 10 m (1 kg to 10⁶ kg) and two pairs of coefficients: a box sliding on the ground
+//! decelerates at μd·g, one pushed with a force between μd·m·g and μs·m·g from rest stays put,
+//! and one pushed harder accelerates at F/m − μd·g. The materials' dynamic
 //! coefficient (`BodyDesc::with_dynamic_friction`, scene field `dynamic_friction`) defaults to
 //! the static one, so every scene keeps its meaning.
 
@@ -12,12 +13,29 @@ use jostle::{BodyDesc, BodyHandle, ResolverChoice, ShapeDesc, Vec3, World, World
 
 const G: f32 = 9.81;
 const DT: f32 = 1.0 / 60.0;
-const STATIC: f32 = 0.8;
-const DYNAMIC: f32 = 0.4;
 
-/// A 1 m cube of `mass` kg resting on the ground, both with μs 0.8 and μd 0.4, moving at
-/// `speed` along x; sleeping off.
-fn cube_on_ground(resolver: &ResolverChoice, speed: f32, mass: f32) -> (World, BodyHandle) {
+/// One case of the family: a cube of side `size` (m) at 1,000 kg/m³ (1 kg to 10⁶ kg) on the
+/// ground, both surfaces with static `mu_s` and dynamic `mu_d`.
+#[derive(Clone, Copy, Debug)]
+struct Case {
+    size: f32,
+    mu_s: f32,
+    mu_d: f32,
+}
+
+/// Cubes of 0.1, 1 and 10 m, each with two pairs of coefficients.
+fn family() -> Vec<Case> {
+    let mut cases = Vec::new();
+    for size in [0.1, 1.0, 10.0] {
+        for (mu_s, mu_d) in [(0.8, 0.4), (0.5, 0.3)] {
+            cases.push(Case { size, mu_s, mu_d });
+        }
+    }
+    cases
+}
+
+/// The case's cube resting on the ground, moving at `speed` along x; sleeping off.
+fn cube_on_ground(resolver: &ResolverChoice, case: Case, speed: f32) -> (World, BodyHandle, f32) {
     let mut settings = WorldSettings {
         resolver: resolver.clone(),
         ..WorldSettings::default()
@@ -26,26 +44,27 @@ fn cube_on_ground(resolver: &ResolverChoice, speed: f32, mass: f32) -> (World, B
     let mut w = World::new(settings);
     w.add_body(
         BodyDesc::fixed("ground", ShapeDesc::HalfSpace { normal: Vec3::Y })
-            .with_material(STATIC, 0.0)
-            .with_dynamic_friction(DYNAMIC),
+            .with_material(case.mu_s, 0.0)
+            .with_dynamic_friction(case.mu_d),
     )
     .unwrap();
+    let half = 0.5 * case.size;
     let cube = w
         .add_body(
             BodyDesc::dynamic(
                 "cube",
                 ShapeDesc::Cuboid {
-                    half_extents: Vec3::splat(0.5),
+                    half_extents: Vec3::splat(half),
                 },
             )
-            .at(Vec3::new(0.0, 0.5, 0.0))
-            .with_mass(mass)
-            .with_material(STATIC, 0.0)
-            .with_dynamic_friction(DYNAMIC)
+            .at(Vec3::new(0.0, half, 0.0))
+            .with_material(case.mu_s, 0.0)
+            .with_dynamic_friction(case.mu_d)
             .moving(Vec3::new(speed, 0.0, 0.0), Vec3::ZERO),
         )
         .unwrap();
-    (w, cube)
+    let mass = w.body(cube).unwrap().mass();
+    (w, cube, mass)
 }
 
 /// Steps `w` for `seconds`, pushing `cube` with `force` (N) every step; returns the cube's
@@ -72,52 +91,60 @@ fn acceleration(track: &[(f32, f32)], i: usize, j: usize) -> f32 {
 #[test]
 fn a_sliding_box_decelerates_at_the_dynamic_coefficient() {
     for r in resolvers() {
-        let (mut w, cube) = cube_on_ground(&r, 4.0, 10.0);
-        let track = run(&mut w, cube, Vec3::ZERO, 2.0);
-        // Between 0.1 s and 0.8 s it is sliding all along: −μd·g = −3.92 m/s² (μs would give
-        // −7.85).
-        let a = acceleration(&track, 6, 48);
-        assert!(
-            (a + DYNAMIC * G).abs() < 0.02 * DYNAMIC * G,
-            "{}: deceleration {a} m/s², expected {}",
-            r.name(),
-            -DYNAMIC * G
-        );
-        // It stops after v₀²/(2·μd·g) = 2.04 m, and stays stopped.
-        let (x, v) = *track.last().unwrap();
-        let expected = 16.0 / (2.0 * DYNAMIC * G);
-        assert!(
-            (x - expected).abs() < 0.03 * expected,
-            "{}: slid {x} m, expected {expected}",
-            r.name()
-        );
-        assert!(v.abs() < 1e-3, "{}: still moving at {v} m/s", r.name());
+        for case in family() {
+            let (mut w, cube, _) = cube_on_ground(&r, case, 4.0);
+            let track = run(&mut w, cube, Vec3::ZERO, 2.0);
+            // Between 0.1 s and 0.8 s it is sliding all along: −μd·g (μs would be far more).
+            let a = acceleration(&track, 6, 48);
+            let expected = -case.mu_d * G;
+            assert!(
+                (a - expected).abs() < 0.02 * expected.abs(),
+                "{} {case:?}: deceleration {a} m/s², expected {expected}",
+                r.name()
+            );
+            // It stops after v₀²/(2·μd·g), and stays stopped.
+            let (x, v) = *track.last().unwrap();
+            let distance = 16.0 / (2.0 * case.mu_d * G);
+            assert!(
+                (x - distance).abs() < 0.03 * distance,
+                "{} {case:?}: slid {x} m, expected {distance}",
+                r.name()
+            );
+            assert!(
+                v.abs() < 1e-3,
+                "{} {case:?}: still moving at {v} m/s",
+                r.name()
+            );
+        }
     }
 }
 
 #[test]
 fn a_push_below_static_friction_moves_nothing_and_above_it_slides_at_the_dynamic_rate() {
-    let mass = 10.0;
     for r in resolvers() {
-        // 0.6·m·g: above μd·m·g, below μs·m·g. Static friction holds it.
-        let (mut w, cube) = cube_on_ground(&r, 0.0, mass);
-        let track = run(&mut w, cube, Vec3::new(0.6 * mass * G, 0.0, 0.0), 2.0);
-        let (x, v) = *track.last().unwrap();
-        assert!(
-            x.abs() < 1e-3 && v.abs() < 1e-3,
-            "{}: pushed at 0.6·m·g it moved {x} m ({v} m/s)",
-            r.name()
-        );
-        // 0.9·m·g: it breaks free and accelerates at F/m − μd·g = 0.5·g.
-        let (mut w, cube) = cube_on_ground(&r, 0.0, mass);
-        let track = run(&mut w, cube, Vec3::new(0.9 * mass * G, 0.0, 0.0), 1.0);
-        let a = acceleration(&track, 12, 59);
-        let expected = (0.9 - DYNAMIC) * G;
-        assert!(
-            (a - expected).abs() < 0.02 * expected,
-            "{}: pushed at 0.9·m·g it accelerated at {a} m/s², expected {expected}",
-            r.name()
-        );
+        for case in family() {
+            // Halfway between μd·m·g and μs·m·g: static friction holds it.
+            let (mut w, cube, mass) = cube_on_ground(&r, case, 0.0);
+            let hold = 0.5 * (case.mu_s + case.mu_d);
+            let track = run(&mut w, cube, Vec3::new(hold * mass * G, 0.0, 0.0), 2.0);
+            let (x, v) = *track.last().unwrap();
+            assert!(
+                x.abs() < 1e-3 && v.abs() < 1e-3,
+                "{} {case:?}: pushed at {hold}·m·g it moved {x} m ({v} m/s)",
+                r.name()
+            );
+            // 0.1·m·g above μs·m·g: it breaks free and accelerates at F/m − μd·g.
+            let (mut w, cube, mass) = cube_on_ground(&r, case, 0.0);
+            let push = case.mu_s + 0.1;
+            let track = run(&mut w, cube, Vec3::new(push * mass * G, 0.0, 0.0), 1.0);
+            let a = acceleration(&track, 12, 59);
+            let expected = (push - case.mu_d) * G;
+            assert!(
+                (a - expected).abs() < 0.02 * expected,
+                "{} {case:?}: pushed at {push}·m·g it accelerated at {a} m/s², expected {expected}",
+                r.name()
+            );
+        }
     }
 }
 

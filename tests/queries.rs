@@ -167,10 +167,7 @@ fn a_body_moved_after_the_update_is_found_where_it_is() {
     // Far from everything, where the tree holds no box.
     w.set_pose(b, Vec3::new(40.0, 5.0, 0.0), Quat::IDENTITY)
         .unwrap();
-    assert!(
-        !w.queries_use_tree(),
-        "a change to a body makes the tree stale"
-    );
+    assert!(!w.queries_use_tree(), "a pose set makes the tree stale");
     let hit = w
         .queries()
         .ray_cast(

@@ -654,8 +654,15 @@ impl Substeps<'_> {
             timing.time(Timing::RELAX, || {
                 for _ in 0..self.relax_iterations {
                     self.each_batch_range(crew, |m, p, base| {
-                        let sweeps = if self.block_relax { 0 } else { self.sweeps };
-                        solve::relax_range(m, p, base, self.states, self.inv_h, sweeps);
+                        solve::relax_range(
+                            m,
+                            p,
+                            base,
+                            self.states,
+                            self.inv_h,
+                            self.sweeps,
+                            self.block_relax,
+                        );
                     });
                     self.direct_correct(crew, solve::RowPass::Relax { inv_h: self.inv_h });
                 }

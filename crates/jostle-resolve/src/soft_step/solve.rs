@@ -465,9 +465,16 @@ fn solve_normal_rigid<F: Lane>(pair: &mut Pair<F>, p: &mut PointLanes<F>, s: F, 
 /// The increment of one rigid, unbiased normal row before the clamp ([`solve_normal_rigid`]).
 #[inline(always)]
 fn rigid_row<F: Lane>(pair: &Pair<F>, p: &PointLanes<F>, s: F, inv_h: F) -> F {
+    -p.normal_mass * rigid_residual(pair, p, s, inv_h)
+}
+
+/// What a rigid row asks to remove: the normal velocity, plus a speculative point's gap
+/// rule s/h (it may close at most its gap `s` within the substep).
+#[inline(always)]
+fn rigid_residual<F: Lane>(pair: &Pair<F>, p: &PointLanes<F>, s: F, inv_h: F) -> F {
     let bias = F::select(s.cmpgt(F::ZERO), s * inv_h, F::ZERO);
     let vn = pair.relative_velocity(p).dot(p.normal);
-    -p.normal_mass * (vn + bias)
+    vn + bias
 }
 
 /// Which pass a row of [`row_residuals`] is taken in.
@@ -708,12 +715,10 @@ fn relax_block<F: Lane>(
     // gap rule in the block: its bias s/h, which K need not be able to produce; excluding such
     // lanes instead (solved point by point) let the column of 10 m boxes sway 1.4 m.
     for (i, p) in points.iter().take(n).enumerate() {
-        let live = p.normal_mass.cmpgt(F::ZERO);
         // A padding point's row is zero: its right-hand side too.
-        let bias = F::select(p.separation.cmpgt(F::ZERO), p.separation * inv_h, F::ZERO);
         b[i] = F::select(
-            live,
-            pair.relative_velocity(p).dot(p.normal) + bias,
+            p.normal_mass.cmpgt(F::ZERO),
+            rigid_residual(pair, p, p.separation, inv_h),
             F::ZERO,
         );
     }
@@ -739,12 +744,10 @@ fn relax_block<F: Lane>(
         }
         x[i] = s * l[6 + i];
     }
-    // Where every point's total stays a push, the block's impulses; in a lane where one
-    // would pull, none of them: clamping that point alone would turn the opposite impulses of
-    // a face's twist (which the system leaves nearly free) into a net push. Such lanes are
-    // solved point after point instead.
-    // `pulls` marks the lanes solved point by point: a lane the block does not serve, or one
-    // where some point's total would pull.
+    // `pulls` marks the lanes solved point by point instead: a lane the block does not serve,
+    // or one where some point's total would pull. Clamping that point alone would turn the
+    // opposite impulses of a face's twist (which the system leaves nearly free) into a net
+    // push, so such a lane takes none of the block's impulses.
     let mut pulls = single;
     for (p, &dx) in points.iter().zip(&x).take(n) {
         pulls = pulls | (p.normal_impulse + dx).cmplt(F::ZERO);
@@ -1076,9 +1079,10 @@ fn relax_impl<F: Lane>(
     states: &[Shared<BodyState>],
     inv_h: f32,
     sweeps: u32,
+    block: bool,
 ) {
     let mut rest = manifolds;
-    if sweeps == 0 {
+    if block {
         // Block relax (`SoftStepSettings::block_relax`).
         let inv_h_lanes = F::splat(inv_h);
         for_each_batch!(
@@ -1161,18 +1165,24 @@ fn two_batches<'a, F>(
 /// One relax pass: rigid, without bias, so the velocity the soft constraints' bleed let
 /// through is removed again once the positions moved (speculative contacts keep their gap
 /// rule); `sweeps` > 1 sweeps each manifold's normal rows that often before its friction
-/// (rigid contacts).
-pub fn relax(batches: &mut Batches, states: &mut [BodyState], inv_h: f32, sweeps: u32) {
-    debug_assert!(sweeps > 0);
+/// (rigid contacts); with `block`, each manifold's normal rows are solved together
+/// ([`relax_block`], after [`factor_blocks`]).
+pub fn relax(
+    batches: &mut Batches,
+    states: &mut [BodyState],
+    inv_h: f32,
+    sweeps: u32,
+    block: bool,
+) {
     let states = share(states);
     by_group(batches, |m, p, base| {
-        relax_range(m, p, base, states, inv_h, sweeps)
+        relax_range(m, p, base, states, inv_h, sweeps, block)
     });
 }
 
 wide_kernel! {
     /// [`relax`] over some batches of one group ([`Batches::groups`]).
-    pub(crate) fn relax_range(inv_h: f32, sweeps: u32) = relax_impl;
+    pub(crate) fn relax_range(inv_h: f32, sweeps: u32, block: bool) = relax_impl;
 }
 
 /// Runs `f(manifolds, points, base)` on each group of batches ([`Batches::groups`]) in
@@ -1537,13 +1547,16 @@ mod tests {
             sweeps: 3,
             ..SOFT
         };
-        for pass in [SOFT, RIGID] {
-            kernels_match(pass);
+        for (pass, block) in [(SOFT, false), (RIGID, false), (SOFT, true)] {
+            kernels_match(pass, block);
         }
     }
 
-    fn kernels_match(pass: BiasedPass) {
-        let (batches, states) = pile();
+    fn kernels_match(pass: BiasedPass, block: bool) {
+        let (mut batches, states) = pile();
+        if block {
+            factor_blocks(&mut batches);
+        }
         assert!(batches.contacts > 1000);
         let inv_h = 4.0 / DT;
 
@@ -1563,7 +1576,7 @@ mod tests {
         );
         let narrow_shared = share(&mut narrow_states);
         by_group(&mut narrow_batches, |m, p, base| {
-            relax_impl::<F8>(m, p, base, narrow_shared, inv_h, pass.sweeps)
+            relax_impl::<F8>(m, p, base, narrow_shared, inv_h, pass.sweeps, block)
         });
         // The pile starts overlapping, so the split push-out did work too.
         assert!(narrow_pseudo.iter().flatten().any(|&x| x != 0.0));
@@ -1584,7 +1597,7 @@ mod tests {
             let mut pseudo = vec![[0.0; 8]; states.len()];
             warm_start(&mut batches, &mut states);
             solve(&mut batches, &mut states, &mut pseudo, pass);
-            relax(&mut batches, &mut states, inv_h, pass.sweeps);
+            relax(&mut batches, &mut states, inv_h, pass.sweeps, block);
             let mut wide = bits(&states, &batches);
             wide.extend(pseudo.iter().flatten().map(|x| x.to_bits()));
             assert_eq!(wide.len(), narrow.len());
