@@ -3,7 +3,7 @@
 //! with serde so that a run can stop and continue **bit for bit**: N steps, a snapshot, then M
 //! steps give exactly the trace of N + M steps in one run.
 //!
-//! Files are RON (`Snapshot(format: 1, ...)`); floats are written in Rust's shortest
+//! Files are RON (`Snapshot(format: 2, ...)`); floats are written in Rust's shortest
 //! round-trip form, so nothing is lost. The broad phase is not stored: its pairs are a pure
 //! function of the poses (sorted, filtered exactly), so it is rebuilt on the first step.
 
@@ -32,15 +32,17 @@ mod file {
     use super::ColliderRecord;
     use crate::settings::WorldSettings;
     use crate::world::World;
-    use jostle_body::{BodySet, RigidBody};
-    use jostle_collide::{Collider, NarrowPhase};
+    use jostle_body::{Arena, BodySet, RigidBody};
+    use jostle_collide::{Collider, ColliderSet, NarrowPhase};
     use jostle_sleep::IslandSet;
     use serde::{Deserialize, Serialize};
     use std::path::Path;
     use thiserror::Error;
 
     /// Version of the snapshot format this build reads and writes.
-    pub const SNAPSHOT_FORMAT: u32 = 1;
+    /// Format 2 (2026-12-03): bodies carry their names, and the colliders are stored with
+    /// their slots, generations and free list, so handles stay valid across removals.
+    pub const SNAPSHOT_FORMAT: u32 = 2;
 
     /// The complete state of a world. Make one with [`World::snapshot`], restore it with
     /// [`World::from_snapshot`], store it with [`Snapshot::save`] / [`Snapshot::load`].
@@ -55,8 +57,7 @@ mod file {
         pub dt: f32,
         pub(crate) settings: WorldSettings,
         pub(crate) bodies: BodySet,
-        pub(crate) names: Vec<String>,
-        pub(crate) colliders: Vec<ColliderRecord>,
+        pub(crate) colliders: Arena<ColliderRecord>,
         pub(crate) narrow: NarrowPhase,
         pub(crate) islands: IslandSet,
         pub(crate) time: f64,
@@ -97,6 +98,11 @@ mod file {
     }
 
     impl Snapshot {
+        /// The snapshot as RON text, as [`Snapshot::save`] writes it.
+        pub fn to_ron(&self) -> Result<String, ron::Error> {
+            ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default().struct_names(true))
+        }
+
         /// Writes the snapshot as RON.
         pub fn save(&self, path: impl AsRef<Path>) -> Result<(), SnapshotError> {
             let path = path.as_ref();
@@ -104,11 +110,7 @@ mod file {
                 file: path.display().to_string(),
                 message,
             };
-            let text = ron::ser::to_string_pretty(
-                self,
-                ron::ser::PrettyConfig::default().struct_names(true),
-            )
-            .map_err(|e| io(e.to_string()))?;
+            let text = self.to_ron().map_err(|e| io(e.to_string()))?;
             std::fs::write(path, text).map_err(|e| io(e.to_string()))
         }
 
@@ -237,8 +239,21 @@ mod file {
                 dt,
                 settings: self.settings.clone(),
                 bodies: self.bodies.clone(),
-                names: self.names.clone(),
-                colliders: self.records.clone(),
+                colliders: self
+                    .colliders
+                    .arena()
+                    .try_map(|_, c| {
+                        Ok::<_, std::convert::Infallible>(ColliderRecord {
+                            shape: c
+                                .desc()
+                                .expect("every collider of a World is built from a description")
+                                .clone(),
+                            local_pose: c.local_pose(),
+                            material: c.material,
+                            body: c.body,
+                        })
+                    })
+                    .unwrap_or_else(|never| match never {}),
                 narrow: self.narrow.clone(),
                 islands: self.islands.clone(),
                 time: self.time,
@@ -254,50 +269,36 @@ mod file {
             };
             validate_settings(&snapshot.settings).map_err(invalid)?;
             let mut world = World::new(snapshot.settings);
+            snapshot
+                .bodies
+                .check()
+                .map_err(|e| invalid(format!("bodies: {e}")))?;
+            snapshot
+                .colliders
+                .check()
+                .map_err(|e| invalid(format!("colliders: {e}")))?;
             world.bodies = snapshot.bodies;
-            for (i, record) in snapshot.colliders.into_iter().enumerate() {
+            let slots: Vec<_> = world.bodies.iter().map(|(h, _)| h).collect();
+            for handle in slots {
+                if let Some(body) = world.bodies.get_mut(handle)
+                    && let Err((field, message)) =
+                        body.check().and_then(|()| within_limits(body, snapshot.dt))
+                {
+                    return Err(invalid(format!(
+                        "body {} \"{}\": field `{field}`: {message}",
+                        handle.index(),
+                        body.name
+                    )));
+                }
+            }
+            for (at, record) in snapshot.colliders.iter() {
+                let i = at.index;
                 if !world.bodies.contains(record.body) {
                     return Err(invalid(format!(
                         "collider {i} is attached to {}, which the snapshot does not hold",
                         record.body
                     )));
                 }
-                let shape = record
-                    .shape
-                    .build()
-                    .map_err(|e| invalid(format!("collider {i}: {e}")))?;
-                let handle = world.colliders.insert(Collider {
-                    shape,
-                    local_pose: record.local_pose,
-                    material: record.material,
-                    body: record.body,
-                });
-                debug_assert_eq!(
-                    handle.index() as usize,
-                    i,
-                    "colliders are never removed, so handles are dense"
-                );
-                world.display.insert(handle, &record.shape);
-                world.records.push(record);
-            }
-            if snapshot.names.len() < world.bodies.capacity_index() {
-                return Err(invalid("fewer body names than body slots".into()));
-            }
-            world.names = snapshot.names;
-            let slots: Vec<_> = world.bodies.iter().map(|(h, _)| h).collect();
-            for handle in slots {
-                let name = &world.names[handle.index() as usize];
-                if let Some(body) = world.bodies.get_mut(handle)
-                    && let Err((field, message)) =
-                        body.check().and_then(|()| within_limits(body, snapshot.dt))
-                {
-                    return Err(invalid(format!(
-                        "body {} \"{name}\": field `{field}`: {message}",
-                        handle.index()
-                    )));
-                }
-            }
-            for (i, record) in world.records.iter().enumerate() {
                 let m = record.material;
                 if !(m.friction.is_finite() && m.friction >= 0.0) {
                     return Err(invalid(format!(
@@ -337,6 +338,14 @@ mod file {
                     )));
                 }
             }
+            let colliders = snapshot.colliders.try_map(|at, record| {
+                let collider = Collider::from_desc(&record.shape, record.body)
+                    .map_err(|e| invalid(format!("collider {}: {e}", at.index)))?;
+                Ok(collider
+                    .with_local_pose(record.local_pose)
+                    .with_material(record.material))
+            })?;
+            world.colliders = ColliderSet::from_arena(colliders);
             let inv_mass = |c: &Collider| world.bodies.get(c.body).map_or(0.0, |b| b.inv_mass());
             snapshot
                 .narrow

@@ -114,7 +114,6 @@ pub(crate) fn gather(
     dt: f32,
     scratch: &mut Scratch,
     report: &mut StepReport,
-    names: &[String],
 ) {
     // Which contacts slide, before the forces change the velocities; only where a dynamic
     // coefficient differs from the static one (every other scene skips this).
@@ -143,9 +142,7 @@ pub(crate) fn gather(
         apply_forces(body, dt);
         if !body.is_finite() {
             body.freeze();
-            report
-                .quarantined
-                .push((handle, names[handle.index() as usize].clone()));
+            report.quarantined.push((handle, body.name.clone()));
             continue;
         }
         scratch.solver_index[handle.index() as usize] = scratch.bodies.len() as u32;
@@ -207,12 +204,11 @@ pub(crate) fn gather(
 /// angular one in the body's frame) less the acceleration of the dropped part of the step, so the
 /// next step's contact resolves the impact (the seed lecture's "move them back to the point
 /// of first collision"). A slow body costs one motion test: a few multiplies and two square
-/// roots. `shapes` is indexed by collider slot.
+/// roots.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn ccd(
     bodies: &BodySet,
     colliders: &ColliderSet,
-    shapes: &[CcdShape],
     broad: &BroadPhase,
     settings: &CcdSettings,
     dt: f32,
@@ -226,12 +222,12 @@ pub(crate) fn ccd(
     // First which colliders are fast (swept); those of other awake bodies are slow targets,
     // taken at their start poses (a bullet into a stack of awake boxes).
     scratch.ccd_fast.clear();
-    scratch.ccd_fast.resize(shapes.len(), false);
+    scratch.ccd_fast.resize(colliders.capacity_index(), false);
     for (handle, collider) in colliders.iter() {
         if sweep_motion(
             bodies,
             collider,
-            &shapes[handle.index() as usize],
+            collider.ccd_shape(),
             settings,
             dt,
             scratch,
@@ -245,7 +241,7 @@ pub(crate) fn ccd(
         if !scratch.ccd_fast[handle.index() as usize] {
             continue;
         }
-        let shape = &shapes[handle.index() as usize];
+        let shape = collider.ccd_shape();
         let (Some(body), Some((solver, motion))) = (
             bodies.get(collider.body),
             sweep_motion(bodies, collider, shape, settings, dt, scratch),
@@ -519,7 +515,6 @@ pub(crate) fn scatter(
     narrow: &mut NarrowPhase,
     scratch: &Scratch,
     report: &mut StepReport,
-    names: &[String],
 ) {
     for (solver, &slot) in scratch.bodies.iter().zip(&scratch.body_slot).skip(1) {
         let Some((handle, _)) = bodies.by_index(slot) else {
@@ -534,9 +529,7 @@ pub(crate) fn scatter(
             && solver.angular_velocity.is_finite();
         if !finite {
             body.freeze();
-            report
-                .quarantined
-                .push((handle, names[slot as usize].clone()));
+            report.quarantined.push((handle, body.name.clone()));
             continue;
         }
         body.position = solver.position;

@@ -3,15 +3,14 @@
 //!
 //! In: the world's bodies and colliders. Out: [`BodyView`]s and [`PlaneView`]s of plain glam
 //! types, so a renderer depends on the facade alone and never on parry. A collider's display
-//! mesh is tessellated the first time it is viewed and kept with the world (a world that is
+//! mesh is tessellated the first time it is viewed and kept with the collider (a world that is
 //! never drawn pays nothing), so drawing a frame never re-tessellates. Nothing here changes
 //! the simulation.
 
 use crate::world::World;
 use jostle_body::BodyHandle;
-use jostle_collide::{ColliderHandle, DisplayMesh, ShapeDesc};
+use jostle_collide::DisplayMesh;
 use jostle_math::{Quat, Vec3};
-use std::sync::OnceLock;
 
 /// One body as a renderer sees it.
 #[derive(Clone, Copy, Debug)]
@@ -48,54 +47,13 @@ pub struct PlaneView {
     pub normal: Vec3,
 }
 
-/// What the world keeps per collider slot for drawing.
-#[derive(Debug, Default)]
-struct Slot {
-    collider: Option<ColliderHandle>,
-    /// The half-space normal in the body's frame, unit, for half-space colliders.
-    plane_normal: Option<Vec3>,
-    mesh: OnceLock<Option<DisplayMesh>>,
-}
-
-/// The world's drawing cache: per collider slot, the lazily built display mesh.
-#[derive(Debug, Default)]
-pub(crate) struct DisplayCache {
-    slots: Vec<Slot>,
-}
-
-impl DisplayCache {
-    /// Records a new collider (resetting a reused slot) built from `shape`.
-    pub(crate) fn insert(&mut self, collider: ColliderHandle, shape: &ShapeDesc) {
-        let index = collider.index() as usize;
-        if self.slots.len() <= index {
-            self.slots.resize_with(index + 1, Slot::default);
-        }
-        let plane_normal = match shape {
-            ShapeDesc::HalfSpace { normal } => normal.try_normalize(),
-            _ => None,
-        };
-        self.slots[index] = Slot {
-            collider: Some(collider),
-            plane_normal,
-            mesh: OnceLock::new(),
-        };
-    }
-
-    fn slot(&self, collider: ColliderHandle) -> Option<&Slot> {
-        self.slots
-            .get(collider.index() as usize)
-            .filter(|s| s.collider == Some(collider))
-    }
-}
-
 impl World {
     /// Every body with a finite shape (all but half-spaces), with its pose, state and display
     /// mesh, in a deterministic order (collider slot order).
     pub fn body_views(&self) -> impl Iterator<Item = BodyView<'_>> {
-        self.colliders.iter().filter_map(|(handle, collider)| {
-            let slot = self.display.slot(handle)?;
+        self.colliders.iter().filter_map(|(_, collider)| {
             let body = self.bodies.get(collider.body)?;
-            let mesh = slot.mesh.get_or_init(|| collider.display_mesh()).as_ref()?;
+            let mesh = collider.display()?;
             Some(BodyView {
                 handle: collider.body,
                 position: body.position,
@@ -109,8 +67,8 @@ impl World {
 
     /// Every half-space, as the plane that bounds it, in collider slot order.
     pub fn half_space_views(&self) -> impl Iterator<Item = PlaneView> + '_ {
-        self.colliders.iter().filter_map(|(handle, collider)| {
-            let normal = self.display.slot(handle)?.plane_normal?;
+        self.colliders.iter().filter_map(|(_, collider)| {
+            let normal = collider.shape().as_halfspace()?.normal;
             let body = self.bodies.get(collider.body)?;
             let pose = collider.world_pose(body);
             Some(PlaneView {

@@ -10,8 +10,8 @@ use crate::settings::WorldSettings;
 use crate::stages::{self, Scratch};
 use jostle_body::{BodyHandle, BodySet, RigidBody};
 use jostle_collide::{
-    BodyContact, BroadPhase, CcdShape, Collider, ColliderSet, CollisionEvent, NarrowPhase, Queries,
-    QueryFilter, RayHit, mass_properties,
+    BodyContact, BroadPhase, Collider, ColliderHandle, ColliderSet, CollisionEvent, NarrowPhase,
+    Queries, QueryFilter, RayHit, mass_properties,
 };
 use jostle_math::{Quat, Vec3};
 use jostle_resolve::{Resolver, StepContext};
@@ -28,6 +28,9 @@ pub enum StepError {
     /// The handle is stale (its body was removed) or was never issued by this world.
     #[error("invalid or stale body handle {0}")]
     InvalidHandle(BodyHandle),
+    /// The handle is stale (its collider was removed) or was never issued by this world.
+    #[error("invalid or stale collider handle {0}")]
+    InvalidCollider(ColliderHandle),
     /// A value given through the API is not finite.
     #[error("{what} must be finite, got {value}")]
     NonFinite {
@@ -62,20 +65,11 @@ pub struct World {
     pub(crate) settings: WorldSettings,
     pub(crate) bodies: BodySet,
     pub(crate) colliders: ColliderSet,
-    /// Display meshes and planes for [`crate::view`], built on first view.
-    pub(crate) display: crate::view::DisplayCache,
-    pub(crate) names: Vec<String>,
-    /// How every collider was made, in insertion order, so a snapshot can rebuild them with
-    /// the same handles.
-    pub(crate) records: Vec<crate::snapshot::ColliderRecord>,
     broad: BroadPhase,
     pub(crate) narrow: NarrowPhase,
     pub(crate) islands: IslandSet,
     resolver: Box<dyn Resolver>,
     profile: StepProfile,
-    /// Thickness and extent of every collider, by slot, for CCD's motion test; filled for new
-    /// colliders (added bodies, restored snapshots) at the next step.
-    ccd_shapes: Vec<CcdShape>,
     pub(crate) time: f64,
     pub(crate) steps: u64,
     scratch: Scratch,
@@ -93,15 +87,11 @@ impl World {
             settings,
             bodies: BodySet::new(),
             colliders: ColliderSet::default(),
-            display: Default::default(),
-            names: Vec::new(),
-            records: Vec::new(),
             broad: BroadPhase::default(),
             narrow: NarrowPhase::default(),
             islands: IslandSet::new(),
             resolver,
             profile: StepProfile::default(),
-            ccd_shapes: Vec::new(),
             time: 0.0,
             steps: 0,
             scratch: Scratch::default(),
@@ -181,26 +171,100 @@ impl World {
         body.sleep.can_sleep = desc.can_sleep;
         body.sleep.motion = 2.0 * self.settings.sleep.threshold;
         body.ccd = desc.ccd;
+        body.name = desc.name;
         let handle = self.bodies.insert(body);
-        let collider = self.colliders.insert(Collider {
-            shape,
-            local_pose,
-            material: desc.material,
-            body: handle,
-        });
-        self.display.insert(collider, &desc.shape);
-        self.records.push(crate::snapshot::ColliderRecord {
-            shape: desc.shape.clone(),
-            local_pose,
-            material: desc.material,
-            body: handle,
-        });
-        let slot = handle.index() as usize;
-        if self.names.len() <= slot {
-            self.names.resize(slot + 1, String::new());
-        }
-        self.names[slot] = desc.name;
+        self.colliders.insert(
+            Collider::new(shape, handle)
+                .with_desc(desc.shape)
+                .with_local_pose(local_pose)
+                .with_material(desc.material),
+        );
         Ok(handle)
+    }
+
+    /// Removes a body and its colliders, and returns the body. Its handle, and its
+    /// colliders', go stale: every later call with them is refused with
+    /// [`StepError::InvalidHandle`] (or `None`), even once a new body reuses the slot.
+    ///
+    /// What the body touched or rested on wakes, so that a stack loses its support rather than
+    /// float: the body's sleeping island wakes, and every body it had a contact with. Its
+    /// contacts are gone at once from the narrow phase (a snapshot taken now holds none of
+    /// them); the next step reports each pair it touched as [`CollisionEvent::Stopped`].
+    ///
+    /// ```
+    /// use jostle::{BodyDesc, ShapeDesc, Vec3, World, WorldSettings};
+    ///
+    /// let mut world = World::new(WorldSettings::default());
+    /// let ball = world.add_body(BodyDesc::dynamic("ball", ShapeDesc::Ball { radius: 0.5 })).unwrap();
+    /// let removed = world.remove_body(ball).unwrap();
+    /// assert_eq!(removed.name, "ball");
+    /// assert!(world.body(ball).is_none());
+    /// // A new body may take the slot; the old handle still names nothing.
+    /// let other = world.add_body(BodyDesc::dynamic("other", ShapeDesc::Ball { radius: 0.5 })).unwrap();
+    /// assert_eq!(other.index(), ball.index());
+    /// assert!(world.body(ball).is_none() && world.remove_body(ball).is_err());
+    /// ```
+    pub fn remove_body(&mut self, handle: BodyHandle) -> Result<RigidBody, StepError> {
+        if !self.bodies.contains(handle) {
+            return Err(StepError::InvalidHandle(handle));
+        }
+        self.wake_around(handle);
+        let attached = self.colliders.attached(handle);
+        for &collider in &attached {
+            self.colliders.remove(collider);
+        }
+        self.narrow.remove_colliders(|c| attached.contains(&c));
+        self.stamp += 1;
+        self.bodies
+            .remove(handle)
+            .ok_or(StepError::InvalidHandle(handle))
+    }
+
+    /// Wakes `body`'s sleeping island and every body it has a contact with.
+    fn wake_around(&mut self, body: BodyHandle) {
+        let sleep = &self.settings.sleep;
+        self.islands.wake(&mut self.bodies, body, sleep);
+        let touched: Vec<BodyHandle> = self
+            .narrow
+            .contacts()
+            .iter()
+            .filter_map(|c| match (c.a == body, c.b == body) {
+                (true, _) => Some(c.b),
+                (_, true) => Some(c.a),
+                _ => None,
+            })
+            .collect();
+        for other in touched {
+            self.islands.wake(&mut self.bodies, other, sleep);
+        }
+    }
+
+    /// The colliders attached to a body, in slot order (one per body added with
+    /// [`World::add_body`]); empty for a stale handle.
+    pub fn colliders_of(&self, body: BodyHandle) -> Vec<ColliderHandle> {
+        self.colliders.attached(body)
+    }
+
+    /// The collider behind `handle`, or `None` if the handle is stale or invalid.
+    pub fn collider(&self, handle: ColliderHandle) -> Option<&Collider> {
+        self.colliders.get(handle)
+    }
+
+    /// Removes one collider and returns it; its body stays, with the mass it had (a body
+    /// without colliders touches nothing). The body and what the collider touched wake, as for
+    /// [`World::remove_body`].
+    pub fn remove_collider(&mut self, handle: ColliderHandle) -> Result<Collider, StepError> {
+        let body = self
+            .colliders
+            .get(handle)
+            .ok_or(StepError::InvalidCollider(handle))?
+            .body;
+        self.wake_around(body);
+        self.narrow.remove_colliders(|c| c == handle);
+        self.stamp += 1;
+        self.colliders
+            .remove(handle)
+            .ok_or(StepError::InvalidCollider(handle))
     }
 
     /// The body behind `handle`, or `None` if the handle is stale or invalid.
@@ -210,24 +274,20 @@ impl World {
 
     /// The name the body was added with.
     pub fn body_name(&self, handle: BodyHandle) -> Option<&str> {
-        self.bodies
-            .contains(handle)
-            .then(|| self.names[handle.index() as usize].as_str())
+        self.bodies.get(handle).map(|b| b.name.as_str())
     }
 
-    /// The first body with this name, in insertion order.
+    /// The first body with this name, in slot order.
     pub fn find_body(&self, name: &str) -> Option<BodyHandle> {
         self.bodies
             .iter()
-            .find(|(h, _)| self.names[h.index() as usize] == name)
+            .find(|(_, b)| b.name == name)
             .map(|(h, _)| h)
     }
 
-    /// All bodies with their handles and names, in a deterministic order.
+    /// All bodies with their handles and names, in a deterministic order (slot order).
     pub fn bodies(&self) -> impl Iterator<Item = (BodyHandle, &str, &RigidBody)> {
-        self.bodies
-            .iter()
-            .map(|(h, b)| (h, self.names[h.index() as usize].as_str(), b))
+        self.bodies.iter().map(|(h, b)| (h, b.name.as_str(), b))
     }
 
     /// Number of bodies (fixed ones included).
@@ -561,7 +621,6 @@ impl World {
             dt,
             &mut self.scratch,
             &mut report,
-            &self.names,
         );
         p.gather = t.elapsed();
 
@@ -576,11 +635,9 @@ impl World {
         p.resolve = t.elapsed();
 
         let t = Instant::now();
-        self.sync_ccd_shapes();
         stages::ccd(
             &self.bodies,
             &self.colliders,
-            &self.ccd_shapes,
             &self.broad,
             &self.settings.collide.ccd,
             dt,
@@ -595,7 +652,6 @@ impl World {
             &mut self.narrow,
             &self.scratch,
             &mut report,
-            &self.names,
         );
         p.scatter = t.elapsed();
 
@@ -617,21 +673,6 @@ impl World {
         self.steps += 1;
         self.stamp += 1;
         Ok(report)
-    }
-
-    /// Computes the CCD data of colliders added since the last step (colliders are never
-    /// removed, so slots only grow).
-    fn sync_ccd_shapes(&mut self) {
-        for i in self.ccd_shapes.len()..self.colliders.capacity_index() {
-            let shape = self.colliders.by_index(i as u32).map_or(
-                CcdShape {
-                    thickness: f32::INFINITY,
-                    extent: 0.0,
-                },
-                |(_, c)| CcdShape::of(c),
-            );
-            self.ccd_shapes.push(shape);
-        }
     }
 
     /// Broad and narrow phase, accumulated into the profile.

@@ -63,6 +63,10 @@ pub enum CcdMode {
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct RigidBody {
+    /// The body's name, as given by the user (scene files require one; may be empty). Kept
+    /// with the body, so that removing it leaves nothing behind.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub name: String,
     /// Position of the centre of mass (m).
     pub position: Vec3,
     /// Orientation, body to world (unit quaternion).
@@ -134,6 +138,7 @@ impl RigidBody {
     /// An immovable body (infinite mass and inertia) at the origin.
     pub fn fixed() -> Self {
         Self {
+            name: String::new(),
             position: Vec3::ZERO,
             orientation: Quat::IDENTITY,
             linear_velocity: Vec3::ZERO,
@@ -159,6 +164,12 @@ impl RigidBody {
         self.position = position;
         self.orientation = orientation.normalize();
         self.update_world_inertia();
+        self
+    }
+
+    /// Sets the name (builder style).
+    pub fn with_name(mut self, name: impl Into<String>) -> Self {
+        self.name = name.into();
         self
     }
 
@@ -378,7 +389,8 @@ impl RigidBody {
     /// Used to quarantine a body whose state went non-finite, so it cannot spread NaN.
     pub fn freeze(&mut self) {
         let (position, orientation, sleep) = (self.position, self.orientation, self.sleep);
-        *self = Self::fixed().with_pose(position, orientation);
+        let name = std::mem::take(&mut self.name);
+        *self = Self::fixed().with_pose(position, orientation).with_name(name);
         self.sleep = SleepState {
             awake: false,
             ..sleep

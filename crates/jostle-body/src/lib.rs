@@ -7,10 +7,12 @@
 //! It depends on `jostle-math` only: no shapes, no parry, no contacts.
 #![deny(missing_docs)]
 
+pub mod arena;
 pub mod body;
 pub mod integrate;
 pub mod set;
 
+pub use arena::{Arena, ArenaIndex};
 pub use body::{CcdMode, MassError, RigidBody, SleepState};
 pub use integrate::{apply_forces, integrate_body};
 pub use set::{BodyHandle, BodySet};

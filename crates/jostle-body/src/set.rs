@@ -1,4 +1,4 @@
-//! `BodySet`: bodies addressed by opaque generational handles.
+//! `BodySet`: bodies addressed by opaque generational handles, in an [`Arena`].
 //!
 //! Handles are `Copy` and carry a generation, so a handle to a removed body never reaches the
 //! body that later reuses its slot: look-ups with a stale handle return `None`.
@@ -6,6 +6,7 @@
 //! removals.
 
 use crate::RigidBody;
+use crate::arena::{Arena, ArenaIndex};
 
 /// An opaque, generational, `Copy` handle to a body in a [`BodySet`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -33,20 +34,31 @@ impl std::fmt::Display for BodyHandle {
     }
 }
 
-#[derive(Clone, Debug)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-struct Slot {
-    generation: u32,
-    body: Option<RigidBody>,
+/// The bodies of a world: an [`Arena`] of [`RigidBody`]s behind typed handles.
+#[derive(Clone, Debug, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(transparent)
+)]
+pub struct BodySet {
+    arena: Arena<RigidBody>,
 }
 
-/// The bodies of a world.
-#[derive(Clone, Debug, Default)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct BodySet {
-    slots: Vec<Slot>,
-    free: Vec<u32>,
-    len: usize,
+impl BodyHandle {
+    fn at(self) -> ArenaIndex {
+        ArenaIndex {
+            index: self.index,
+            generation: self.generation,
+        }
+    }
+
+    fn from_at(at: ArenaIndex) -> Self {
+        Self {
+            index: at.index,
+            generation: at.generation,
+        }
+    }
 }
 
 impl BodySet {
@@ -57,54 +69,22 @@ impl BodySet {
 
     /// Adds a body and returns its handle. Reuses the most recently freed slot.
     pub fn insert(&mut self, body: RigidBody) -> BodyHandle {
-        self.len += 1;
-        if let Some(index) = self.free.pop() {
-            let slot = &mut self.slots[index as usize];
-            slot.body = Some(body);
-            BodyHandle {
-                index,
-                generation: slot.generation,
-            }
-        } else {
-            let index = u32::try_from(self.slots.len()).expect("more than u32::MAX bodies");
-            self.slots.push(Slot {
-                generation: 0,
-                body: Some(body),
-            });
-            BodyHandle {
-                index,
-                generation: 0,
-            }
-        }
+        BodyHandle::from_at(self.arena.insert(body))
     }
 
     /// Removes a body; `None` if the handle is stale or invalid.
     pub fn remove(&mut self, handle: BodyHandle) -> Option<RigidBody> {
-        let slot = self.slots.get_mut(handle.index as usize)?;
-        if slot.generation != handle.generation {
-            return None;
-        }
-        let body = slot.body.take()?;
-        slot.generation = slot.generation.wrapping_add(1);
-        self.free.push(handle.index);
-        self.len -= 1;
-        Some(body)
+        self.arena.remove(handle.at())
     }
 
     /// The body behind `handle`, or `None` if it is stale or invalid.
     pub fn get(&self, handle: BodyHandle) -> Option<&RigidBody> {
-        let slot = self.slots.get(handle.index as usize)?;
-        (slot.generation == handle.generation)
-            .then_some(slot.body.as_ref())
-            .flatten()
+        self.arena.get(handle.at())
     }
 
     /// The body behind `handle`, mutably, or `None` if it is stale or invalid.
     pub fn get_mut(&mut self, handle: BodyHandle) -> Option<&mut RigidBody> {
-        let slot = self.slots.get_mut(handle.index as usize)?;
-        (slot.generation == handle.generation)
-            .then_some(slot.body.as_mut())
-            .flatten()
+        self.arena.get_mut(handle.at())
     }
 
     /// Whether `handle` names a live body.
@@ -114,62 +94,43 @@ impl BodySet {
 
     /// Number of live bodies.
     pub fn len(&self) -> usize {
-        self.len
+        self.arena.len()
     }
 
     /// Whether there are no bodies.
     pub fn is_empty(&self) -> bool {
-        self.len == 0
+        self.arena.is_empty()
     }
 
     /// One past the largest slot index ever used: the size of a dense per-slot table.
     pub fn capacity_index(&self) -> usize {
-        self.slots.len()
+        self.arena.capacity_index()
     }
 
     /// Live bodies with their handles, in slot order.
     pub fn iter(&self) -> impl Iterator<Item = (BodyHandle, &RigidBody)> {
-        self.slots.iter().enumerate().filter_map(|(i, s)| {
-            s.body.as_ref().map(|b| {
-                (
-                    BodyHandle {
-                        index: i as u32,
-                        generation: s.generation,
-                    },
-                    b,
-                )
-            })
-        })
+        self.arena
+            .iter()
+            .map(|(at, b)| (BodyHandle::from_at(at), b))
     }
 
     /// Live bodies with their handles, mutably, in slot order.
     pub fn iter_mut(&mut self) -> impl Iterator<Item = (BodyHandle, &mut RigidBody)> {
-        self.slots.iter_mut().enumerate().filter_map(|(i, s)| {
-            let generation = s.generation;
-            s.body.as_mut().map(|b| {
-                (
-                    BodyHandle {
-                        index: i as u32,
-                        generation,
-                    },
-                    b,
-                )
-            })
-        })
+        self.arena
+            .iter_mut()
+            .map(|(at, b)| (BodyHandle::from_at(at), b))
     }
 
     /// The live body in slot `index`, with its handle.
     pub fn by_index(&self, index: u32) -> Option<(BodyHandle, &RigidBody)> {
-        let s = self.slots.get(index as usize)?;
-        s.body.as_ref().map(|b| {
-            (
-                BodyHandle {
-                    index,
-                    generation: s.generation,
-                },
-                b,
-            )
-        })
+        self.arena
+            .by_index(index)
+            .map(|(at, b)| (BodyHandle::from_at(at), b))
+    }
+
+    /// Checks a set read back from a file (its free list and count: [`Arena::check`]).
+    pub fn check(&self) -> Result<(), String> {
+        self.arena.check()
     }
 }
 

@@ -1,26 +1,39 @@
 //! Colliders: a parry shape and a material attached to a body at a local pose, stored in a
-//! [`ColliderSet`] addressed by generational [`ColliderHandle`]s.
+//! [`ColliderSet`] (an [`Arena`], the same as bodies') addressed by generational
+//! [`ColliderHandle`]s.
 //!
 //! In: shapes built from [`crate::ShapeDesc`], the body they belong to. Out: world poses
 //! (body pose × local pose) for the broad phase, narrow phase and queries. Iteration is in slot
 //! order, deterministic for a given sequence of inserts and removals.
 
+use crate::ccd::CcdShape;
+use crate::display::DisplayMesh;
 use crate::material::Material;
-use jostle_body::{BodyHandle, RigidBody};
+use crate::shape::{ShapeDesc, ShapeError};
+use jostle_body::{Arena, ArenaIndex, BodyHandle, RigidBody};
 use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
+use std::sync::OnceLock;
 
-/// A collision shape attached to a body.
+/// A collision shape attached to a body, with what is derived from it (CCD's thickness and
+/// reach, the display mesh) and, when it was built from one, its description: everything a
+/// collider needs travels with it, so removing it leaves no table behind.
 #[derive(Clone)]
 pub struct Collider {
-    /// The shape, in the collider's frame.
-    pub shape: SharedShape,
+    /// The shape, in the collider's frame ([`Collider::set_shape`] keeps the derived data).
+    pub(crate) shape: SharedShape,
     /// Pose of the collider's frame relative to the body's centre-of-mass frame.
-    pub local_pose: Pose,
+    pub(crate) local_pose: Pose,
     /// Surface material.
     pub material: Material,
     /// The body the collider moves with.
     pub body: BodyHandle,
+    /// What CCD needs of the shape, computed whenever the shape or local pose is set.
+    pub(crate) ccd: CcdShape,
+    /// The description the shape was built from ([`Collider::from_desc`]), for snapshots.
+    desc: Option<ShapeDesc>,
+    /// The display mesh, built on first use.
+    display: OnceLock<Option<DisplayMesh>>,
 }
 
 impl std::fmt::Debug for Collider {
@@ -37,17 +50,36 @@ impl std::fmt::Debug for Collider {
 impl Collider {
     /// A collider of `shape` on `body`, at the body's centre of mass, default material.
     pub fn new(shape: SharedShape, body: BodyHandle) -> Self {
-        Self {
+        let mut collider = Self {
             shape,
             local_pose: Pose::IDENTITY,
             material: Material::default(),
             body,
-        }
+            ccd: CcdShape {
+                thickness: 0.0,
+                extent: 0.0,
+            },
+            desc: None,
+            display: OnceLock::new(),
+        };
+        collider.derive();
+        collider
+    }
+
+    /// A collider built from a shape description, which it keeps (snapshots rebuild it).
+    pub fn from_desc(desc: &ShapeDesc, body: BodyHandle) -> Result<Self, ShapeError> {
+        Ok(Self::new(desc.build()?, body).with_desc(desc.clone()))
+    }
+
+    /// Records the description the shape was built from (builder style), for snapshots.
+    pub fn with_desc(mut self, desc: ShapeDesc) -> Self {
+        self.desc = Some(desc);
+        self
     }
 
     /// Sets the pose relative to the body's centre-of-mass frame (builder style).
     pub fn with_local_pose(mut self, local_pose: Pose) -> Self {
-        self.local_pose = local_pose;
+        self.set_local_pose(local_pose);
         self
     }
 
@@ -55,6 +87,52 @@ impl Collider {
     pub fn with_material(mut self, material: Material) -> Self {
         self.material = material;
         self
+    }
+
+    /// The shape, in the collider's frame.
+    pub fn shape(&self) -> &SharedShape {
+        &self.shape
+    }
+
+    /// The pose relative to the body's centre-of-mass frame.
+    pub fn local_pose(&self) -> Pose {
+        self.local_pose
+    }
+
+    /// The description the shape was built from, if it was built from one.
+    pub fn desc(&self) -> Option<&ShapeDesc> {
+        self.desc.as_ref()
+    }
+
+    /// What CCD needs of the shape (thickness and reach about the centre of mass).
+    pub fn ccd_shape(&self) -> &CcdShape {
+        &self.ccd
+    }
+
+    /// Replaces the shape (its description is forgotten); picked up by the next broad- and
+    /// narrow-phase update.
+    pub fn set_shape(&mut self, shape: SharedShape) {
+        self.shape = shape;
+        self.desc = None;
+        self.derive();
+    }
+
+    /// Moves the collider on its body; picked up by the next broad- and narrow-phase update.
+    pub fn set_local_pose(&mut self, local_pose: Pose) {
+        self.local_pose = local_pose;
+        self.derive();
+    }
+
+    /// The display mesh in the body's frame (built once, on first use); `None` for shapes
+    /// without one (half-spaces).
+    pub fn display(&self) -> Option<&DisplayMesh> {
+        self.display.get_or_init(|| self.display_mesh()).as_ref()
+    }
+
+    /// Recomputes what is derived from the shape and local pose.
+    fn derive(&mut self) {
+        self.ccd = CcdShape::of(self);
+        self.display = OnceLock::new();
     }
 
     /// The collider's world pose on `body`: body pose (centre of mass, orientation) × local pose.
@@ -101,6 +179,19 @@ impl ColliderHandle {
     pub fn generation(self) -> u32 {
         self.generation
     }
+
+    /// Where the collider is in its set's [`Arena`].
+    pub fn arena_index(self) -> ArenaIndex {
+        ArenaIndex {
+            index: self.index,
+            generation: self.generation,
+        }
+    }
+
+    /// The handle of the collider at `at` of a set's [`Arena`].
+    pub fn from_arena_index(at: ArenaIndex) -> Self {
+        Self::new(at.index, at.generation)
+    }
 }
 
 impl std::fmt::Display for ColliderHandle {
@@ -109,18 +200,10 @@ impl std::fmt::Display for ColliderHandle {
     }
 }
 
-#[derive(Clone, Debug)]
-struct Slot {
-    generation: u32,
-    collider: Option<Collider>,
-}
-
-/// The colliders of a world, in a Vec of generational slots.
+/// The colliders of a world: an [`Arena`] of [`Collider`]s behind typed handles.
 #[derive(Clone, Debug, Default)]
 pub struct ColliderSet {
-    slots: Vec<Slot>,
-    free: Vec<u32>,
-    len: usize,
+    arena: Arena<Collider>,
 }
 
 impl ColliderSet {
@@ -129,114 +212,80 @@ impl ColliderSet {
         Self::default()
     }
 
+    /// The colliders of an arena (a snapshot's, rebuilt), every handle kept.
+    pub fn from_arena(arena: Arena<Collider>) -> Self {
+        Self { arena }
+    }
+
+    /// The colliders' arena, read-only (to store or map it whole).
+    pub fn arena(&self) -> &Arena<Collider> {
+        &self.arena
+    }
+
     /// Adds a collider and returns its handle. Reuses the most recently freed slot.
     pub fn insert(&mut self, collider: Collider) -> ColliderHandle {
-        self.len += 1;
-        if let Some(index) = self.free.pop() {
-            let slot = &mut self.slots[index as usize];
-            slot.collider = Some(collider);
-            ColliderHandle {
-                index,
-                generation: slot.generation,
-            }
-        } else {
-            let index = u32::try_from(self.slots.len()).expect("more than u32::MAX colliders");
-            self.slots.push(Slot {
-                generation: 0,
-                collider: Some(collider),
-            });
-            ColliderHandle {
-                index,
-                generation: 0,
-            }
-        }
+        ColliderHandle::from_arena_index(self.arena.insert(collider))
     }
 
     /// Removes a collider; `None` if the handle is stale or invalid.
     pub fn remove(&mut self, handle: ColliderHandle) -> Option<Collider> {
-        let slot = self.slots.get_mut(handle.index as usize)?;
-        if slot.generation != handle.generation {
-            return None;
-        }
-        let collider = slot.collider.take()?;
-        slot.generation = slot.generation.wrapping_add(1);
-        self.free.push(handle.index);
-        self.len -= 1;
-        Some(collider)
+        self.arena.remove(handle.arena_index())
+    }
+
+    /// The colliders attached to `body`, in slot order.
+    pub fn attached(&self, body: BodyHandle) -> Vec<ColliderHandle> {
+        self.iter()
+            .filter(|(_, c)| c.body == body)
+            .map(|(h, _)| h)
+            .collect()
     }
 
     /// Removes every collider attached to `body` (when the body is removed); returns how many.
     pub fn remove_attached(&mut self, body: BodyHandle) -> usize {
-        let attached: Vec<ColliderHandle> = self
-            .iter()
-            .filter(|(_, c)| c.body == body)
-            .map(|(h, _)| h)
-            .collect();
-        attached
-            .iter()
-            .filter(|&&h| self.remove(h).is_some())
+        self.attached(body)
+            .into_iter()
+            .filter(|&h| self.remove(h).is_some())
             .count()
     }
 
     /// The collider behind `handle`, or `None` if it is stale or invalid.
     pub fn get(&self, handle: ColliderHandle) -> Option<&Collider> {
-        let slot = self.slots.get(handle.index as usize)?;
-        (slot.generation == handle.generation)
-            .then_some(slot.collider.as_ref())
-            .flatten()
+        self.arena.get(handle.arena_index())
     }
 
-    /// The collider behind `handle`, mutably. Changing its shape or local pose is picked up by
-    /// the next broad- and narrow-phase update.
+    /// The collider behind `handle`, mutably. Changing its shape or local pose (through its
+    /// setters) is picked up by the next broad- and narrow-phase update.
     pub fn get_mut(&mut self, handle: ColliderHandle) -> Option<&mut Collider> {
-        let slot = self.slots.get_mut(handle.index as usize)?;
-        (slot.generation == handle.generation)
-            .then_some(slot.collider.as_mut())
-            .flatten()
+        self.arena.get_mut(handle.arena_index())
     }
 
     /// The live collider in slot `index`, with its handle.
     pub fn by_index(&self, index: u32) -> Option<(ColliderHandle, &Collider)> {
-        let s = self.slots.get(index as usize)?;
-        s.collider.as_ref().map(|c| {
-            (
-                ColliderHandle {
-                    index,
-                    generation: s.generation,
-                },
-                c,
-            )
-        })
+        self.arena
+            .by_index(index)
+            .map(|(at, c)| (ColliderHandle::from_arena_index(at), c))
     }
 
     /// Number of live colliders.
     pub fn len(&self) -> usize {
-        self.len
+        self.arena.len()
     }
 
     /// Whether there are no colliders.
     pub fn is_empty(&self) -> bool {
-        self.len == 0
+        self.arena.is_empty()
     }
 
     /// One past the largest slot index ever used: the size of a dense per-slot table.
     pub fn capacity_index(&self) -> usize {
-        self.slots.len()
+        self.arena.capacity_index()
     }
 
     /// Live colliders with their handles, in slot order.
     pub fn iter(&self) -> impl Iterator<Item = (ColliderHandle, &Collider)> {
-        self.slots.iter().enumerate().filter_map(|(i, s)| {
-            s.collider.as_ref().map(|c| {
-                (
-                    ColliderHandle {
-                        index: i as u32,
-                        generation: s.generation,
-                    },
-                    c,
-                )
-            })
-        })
+        self.arena
+            .iter()
+            .map(|(at, c)| (ColliderHandle::from_arena_index(at), c))
     }
 }
 

@@ -13,7 +13,7 @@
 //! follow the bodies. Pairs that left the candidate list are dropped.
 
 use crate::broad_phase::ColliderPair;
-use crate::collider::{Collider, ColliderSet};
+use crate::collider::{Collider, ColliderHandle, ColliderSet};
 use crate::material::Material;
 use crate::reduce::reduce_manifold;
 use crate::settings::CollideSettings;
@@ -355,6 +355,40 @@ impl NarrowPhase {
     /// Forgets every pair (the next update starts cold: no warm start, no events carried).
     pub fn clear(&mut self) {
         *self = Self::default();
+    }
+
+    /// Forgets every pair that involves a collider `gone` says is removed, with its contacts
+    /// (the remaining contacts keep their order). The touching list is left alone, so the next
+    /// update reports the removed bodies' contacts as [`CollisionEvent::Stopped`].
+    pub fn remove_colliders(&mut self, gone: impl Fn(ColliderHandle) -> bool) {
+        let mut new_index = Vec::with_capacity(self.pairs.len());
+        let mut kept = 0u32;
+        for state in &self.pairs {
+            if gone(state.pair.0) || gone(state.pair.1) {
+                new_index.push(None);
+            } else {
+                new_index.push(Some(kept));
+                kept += 1;
+            }
+        }
+        if kept as usize == self.pairs.len() {
+            return;
+        }
+        let mut i = 0;
+        self.pairs.retain(|_| {
+            i += 1;
+            new_index[i - 1].is_some()
+        });
+        let mut contacts = Vec::with_capacity(self.contacts.len());
+        let mut slots = Vec::with_capacity(self.slots.len());
+        for (contact, slot) in self.contacts.iter().zip(&self.slots) {
+            if let Some(pair) = new_index[slot.pair as usize] {
+                contacts.push(*contact);
+                slots.push(PointSlot { pair, ..*slot });
+            }
+        }
+        self.contacts = contacts;
+        self.slots = slots;
     }
 
     /// Writes the resolver's accumulated impulses back into the persistent points, one per

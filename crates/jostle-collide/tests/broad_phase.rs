@@ -32,7 +32,7 @@ fn brute_force(colliders: &ColliderSet, bodies: &BodySet, margin: f32) -> Vec<Co
             let body = bodies.get(c.body)?;
             let pose = c.world_pose(body);
             let plane = c
-                .shape
+                .shape()
                 .as_halfspace()
                 .map(|hs| (pose, pose.rotation * hs.normal));
             Some((
@@ -40,7 +40,7 @@ fn brute_force(colliders: &ColliderSet, bodies: &BodySet, margin: f32) -> Vec<Co
                 c.body,
                 body.is_awake(),
                 plane,
-                c.shape.compute_aabb(&pose).loosened(margin),
+                c.shape().compute_aabb(&pose).loosened(margin),
             ))
         })
         .collect();
