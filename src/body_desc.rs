@@ -265,47 +265,11 @@ impl BodyDesc {
                 Err(err(field, format!("must be finite and >= 0, got {x}")))
             }
         };
-        non_negative("friction", self.material.friction)?;
-        if let Some(d) = self.material.dynamic_friction {
-            non_negative("dynamic_friction", d)?;
-            if d > self.material.friction {
-                return Err(err(
-                    "dynamic_friction",
-                    format!(
-                        "must be <= friction (the static coefficient, {}), got {d}",
-                        self.material.friction
-                    ),
-                ));
-            }
-        }
+        check_material(&self.material).map_err(|(field, message)| err(field, message))?;
         non_negative("linear_damping", self.linear_damping)?;
         non_negative("angular_damping", self.angular_damping)?;
-        let e = self.material.restitution;
-        if !(e.is_finite() && (0.0..=1.0).contains(&e)) {
-            return Err(err("restitution", format!("must be in [0, 1], got {e}")));
-        }
         if !self.fixed {
-            match self.mass {
-                MassSpec::Mass(m) if !(m.is_finite() && m > 0.0) => {
-                    return Err(err("mass", format!("must be finite and > 0, got {m}")));
-                }
-                MassSpec::Density(d) if !(d.is_finite() && d > 0.0) => {
-                    return Err(err("density", format!("must be finite and > 0, got {d}")));
-                }
-                MassSpec::Mass(m) if m > MAX_MASS => {
-                    return Err(err(
-                        "mass",
-                        format!("{m:e} kg is above the limit of {MAX_MASS:e} kg"),
-                    ));
-                }
-                MassSpec::Density(d) if d > MAX_DENSITY => {
-                    return Err(err(
-                        "density",
-                        format!("{d:e} kg/m³ is above the limit of {MAX_DENSITY:e} kg/m³"),
-                    ));
-                }
-                _ => {}
-            }
+            check_mass(self.mass).map_err(|(field, message)| err(field, message))?;
         }
         self.shape.build().map_err(|e| shape_error(&self.name, e))?;
         if !self.fixed && self.shape.is_unbounded() {
@@ -316,6 +280,85 @@ impl BodyDesc {
         }
         Ok(())
     }
+}
+
+/// Checks a material: friction finite and ≥ 0, dynamic friction in [0, friction], restitution
+/// in [0, 1]. The error names the field.
+pub(crate) fn check_material(m: &Material) -> Result<(), (&'static str, String)> {
+    let non_negative = |field: &'static str, x: f32| {
+        if x.is_finite() && x >= 0.0 {
+            Ok(())
+        } else {
+            Err((field, format!("must be finite and >= 0, got {x}")))
+        }
+    };
+    non_negative("friction", m.friction)?;
+    if let Some(d) = m.dynamic_friction {
+        non_negative("dynamic_friction", d)?;
+        if d > m.friction {
+            return Err((
+                "dynamic_friction",
+                format!(
+                    "must be <= friction (the static coefficient, {}), got {d}",
+                    m.friction
+                ),
+            ));
+        }
+    }
+    let e = m.restitution;
+    if !(e.is_finite() && (0.0..=1.0).contains(&e)) {
+        return Err(("restitution", format!("must be in [0, 1], got {e}")));
+    }
+    Ok(())
+}
+
+/// Checks how a dynamic body's mass is given: finite, > 0 and within [`MAX_MASS`] or
+/// [`MAX_DENSITY`]. The error names the field (`mass` or `density`).
+pub(crate) fn check_mass(spec: MassSpec) -> Result<(), (&'static str, String)> {
+    match spec {
+        MassSpec::Mass(m) if !(m.is_finite() && m > 0.0) => {
+            Err(("mass", format!("must be finite and > 0, got {m}")))
+        }
+        MassSpec::Density(d) if !(d.is_finite() && d > 0.0) => {
+            Err(("density", format!("must be finite and > 0, got {d}")))
+        }
+        MassSpec::Mass(m) if m > MAX_MASS => Err((
+            "mass",
+            format!("{m:e} kg is above the limit of {MAX_MASS:e} kg"),
+        )),
+        MassSpec::Density(d) if d > MAX_DENSITY => Err((
+            "density",
+            format!("{d:e} kg/m³ is above the limit of {MAX_DENSITY:e} kg/m³"),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// The mass properties of `shape` given as `spec`: total mass, body-space inertia tensor and
+/// the centre of mass in the shape's frame. The error names the field.
+pub(crate) fn shape_mass(
+    shape: &ShapeDesc,
+    spec: MassSpec,
+) -> Result<jostle_collide::MassProps, (String, String)> {
+    check_mass(spec).map_err(|(f, m)| (f.to_string(), m))?;
+    let density = match spec {
+        MassSpec::Density(d) => d,
+        MassSpec::Mass(_) => 1.0,
+    };
+    let mut props = jostle_collide::mass_properties(shape, density)
+        .map_err(|e| (format!("shape.{}", e.field()), e.to_string()))?;
+    if let MassSpec::Mass(m) = spec {
+        props = props.scaled_to_mass(m);
+    } else if props.mass > MAX_MASS {
+        return Err((
+            "density".into(),
+            format!(
+                "gives the shape a mass of {:e} kg, above the limit of {MAX_MASS:e} kg",
+                props.mass
+            ),
+        ));
+    }
+    Ok(props)
 }
 
 pub(crate) fn shape_error(body: &str, e: ShapeError) -> BodyError {

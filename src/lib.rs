@@ -42,8 +42,8 @@ pub use body_desc::{
 };
 pub use jostle_body::{BodyHandle, CcdMode, RigidBody};
 pub use jostle_collide::{
-    BodyContact, CollideSettings, CollisionEvent, DisplayMesh, Material, PointHit, Pose, Queries,
-    QueryFilter, RayHit, ShapeDesc, ShapeHit, SharedShape,
+    BodyContact, CollideSettings, CollisionEvent, Combine, DisplayMesh, Material, PointHit, Pose,
+    Queries, QueryFilter, RayHit, ShapeDesc, ShapeHit, SharedShape,
 };
 pub use jostle_math::{Mat3, Quat, Vec3};
 pub use jostle_resolve::soft_step::team::set_threads;

@@ -63,6 +63,14 @@ impl ResolverChoice {
         }
     }
 
+    /// Checks every setting of the chosen resolver; the error names the field.
+    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+        match self {
+            Self::Millington(m) => m.validate(),
+            Self::SoftStep(s) => s.validate(),
+        }
+    }
+
     /// Builds the resolver.
     pub fn build(&self) -> Box<dyn Resolver> {
         match self {

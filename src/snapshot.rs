@@ -159,12 +159,10 @@ mod file {
     /// too (a hand-edited `substeps: 0` or NaN gravity used to be accepted silently, and a
     /// negative or NaN `collide.prediction` stopped the process on an assertion in parry).
     fn validate_settings(settings: &WorldSettings) -> Result<(), String> {
-        use crate::settings::ResolverChoice;
-        let resolver = match &settings.resolver {
-            ResolverChoice::Millington(m) => m.validate(),
-            ResolverChoice::SoftStep(s) => s.validate(),
-        };
-        resolver.map_err(|(field, message)| format!("settings.resolver.{field}: {message}"))?;
+        settings
+            .resolver
+            .validate()
+            .map_err(|(field, message)| format!("settings.resolver.{field}: {message}"))?;
         if !(settings.gravity.is_finite() && settings.gravity.length() <= crate::MAX_GRAVITY) {
             return Err(format!(
                 "settings.gravity: must be finite and at most {:e} m/s², got {}",

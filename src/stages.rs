@@ -112,6 +112,7 @@ pub(crate) fn gather(
     bodies: &mut BodySet,
     contacts: &[BodyContact],
     dt: f32,
+    gravity: Vec3,
     scratch: &mut Scratch,
     report: &mut StepReport,
 ) {
@@ -157,6 +158,11 @@ pub(crate) fn gather(
         sb.linear_velocity = v0;
         sb.angular_velocity = w0;
         sb.force_velocity = body.linear_velocity - v0;
+        if body.gravity_scale != 1.0 {
+            // The resolver adds the world's gravity to every body; the rest of a scaled one's
+            // is one more force, spread over the step like the others.
+            sb.force_velocity += gravity * ((body.gravity_scale - 1.0) * dt);
+        }
         sb.torque_velocity = body.angular_velocity - w0;
         sb.last_acceleration = body.last_acceleration;
         scratch.bodies.push(sb);

@@ -4,14 +4,17 @@
 //! "The step"); each stage is a small function in `stages.rs` over exactly the data it
 //! touches.
 
-use crate::body_desc::{BodyDesc, BodyError, MAX_MASS, MassSpec, shape_error, unit_rotation};
+use crate::body_desc::{
+    BodyDesc, BodyError, DEFAULT_DENSITY, MAX_GRAVITY, MassSpec, check_material, shape_error,
+    shape_mass, unit_rotation,
+};
 use crate::profile::StepProfile;
-use crate::settings::WorldSettings;
+use crate::settings::{ResolverChoice, WorldSettings};
 use crate::stages::{self, Scratch};
-use jostle_body::{BodyHandle, BodySet, RigidBody};
+use jostle_body::{BodyHandle, BodySet, CcdMode, RigidBody};
 use jostle_collide::{
-    BodyContact, BroadPhase, Collider, ColliderHandle, ColliderSet, CollisionEvent, NarrowPhase,
-    Queries, QueryFilter, RayHit, mass_properties,
+    BodyContact, BroadPhase, Collider, ColliderHandle, ColliderSet, CollisionEvent, Material,
+    NarrowPhase, Queries, QueryFilter, RayHit,
 };
 use jostle_math::{Quat, Vec3};
 use jostle_resolve::{Resolver, StepContext};
@@ -39,6 +42,15 @@ pub enum StepError {
         /// The value, formatted.
         value: String,
     },
+    /// A value given through the API is out of its domain; `field` names it as a scene file
+    /// would.
+    #[error("{field}: {message}")]
+    Invalid {
+        /// The field (`friction`, `linear_damping`, `mass`, `resolver.substeps`, ...).
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A value given through the API is beyond what the engine holds
     /// ([`crate::MAX_SPEED`], [`crate::MAX_ANGULAR_SPEED`]).
     #[error("{what} {value} is above the limit of {limit}")]
@@ -50,6 +62,14 @@ pub enum StepError {
         /// The limit, with its unit.
         limit: String,
     },
+}
+
+/// An API value refused with the field it is for.
+fn invalid((field, message): (&str, String)) -> StepError {
+    StepError::Invalid {
+        field: field.to_string(),
+        message,
+    }
 }
 
 /// What a step reports besides the profile.
@@ -73,7 +93,8 @@ pub struct World {
     pub(crate) time: f64,
     pub(crate) steps: u64,
     scratch: Scratch,
-    /// Counts the changes that can move or add a collider (steps, added bodies, poses set);
+    /// Counts the changes that can move, add or remove a collider (steps, added or removed
+    /// bodies and colliders, poses set, bodies made fixed or dynamic);
     /// the broad phase's tree serves queries while `query_stamp` equals it.
     stamp: u64,
     query_stamp: u64,
@@ -129,24 +150,13 @@ impl World {
                 jostle_collide::Pose::IDENTITY,
             )
         } else {
-            let density = match desc.mass {
-                MassSpec::Density(d) => d,
-                MassSpec::Mass(_) => 1.0,
-            };
-            let mut props =
-                mass_properties(&desc.shape, density).map_err(|e| shape_error(&desc.name, e))?;
-            if let MassSpec::Mass(m) = desc.mass {
-                props = props.scaled_to_mass(m);
-            } else if props.mass > MAX_MASS {
-                return Err(BodyError::Field {
+            let props = shape_mass(&desc.shape, desc.mass).map_err(|(field, message)| {
+                BodyError::Field {
                     body: desc.name.clone(),
-                    field: "density".into(),
-                    message: format!(
-                        "gives the shape a mass of {:e} kg, above the limit of {MAX_MASS:e} kg",
-                        props.mass
-                    ),
-                });
-            }
+                    field,
+                    message,
+                }
+            })?;
             let body =
                 RigidBody::dynamic(props.mass, props.inertia).map_err(|e| BodyError::Field {
                     body: desc.name.clone(),
@@ -449,6 +459,269 @@ impl World {
         Ok(())
     }
 
+    // Changes after creation. Each is checked as a scene file's field would be (refused with
+    // the field named, changing nothing) and wakes what it must.
+
+    /// Sets the material of one collider (friction, dynamic friction, restitution and their
+    /// combine rules); picked up by its contacts at the next step. Wakes its body.
+    pub fn set_collider_material(
+        &mut self,
+        handle: ColliderHandle,
+        material: Material,
+    ) -> Result<(), StepError> {
+        check_material(&material).map_err(invalid)?;
+        let collider = self
+            .colliders
+            .get_mut(handle)
+            .ok_or(StepError::InvalidCollider(handle))?;
+        collider.material = material;
+        let body = collider.body;
+        self.islands
+            .wake(&mut self.bodies, body, &self.settings.sleep);
+        Ok(())
+    }
+
+    /// Sets the material of every collider of a body ([`World::set_collider_material`]).
+    ///
+    /// ```
+    /// use jostle::{BodyDesc, Combine, Material, ShapeDesc, World, WorldSettings};
+    ///
+    /// let mut world = World::new(WorldSettings::default());
+    /// let puck = world.add_body(BodyDesc::dynamic("puck", ShapeDesc::Ball { radius: 0.1 })).unwrap();
+    /// // Ice: whatever it slides on, the smaller friction holds.
+    /// let ice = Material::new(0.02, 0.1).with_combine(Combine::Min, Combine::Max);
+    /// world.set_material(puck, ice).unwrap();
+    /// assert!(world.set_material(puck, Material::new(-1.0, 0.0)).is_err());
+    /// ```
+    pub fn set_material(&mut self, body: BodyHandle, material: Material) -> Result<(), StepError> {
+        check_material(&material).map_err(invalid)?;
+        if !self.bodies.contains(body) {
+            return Err(StepError::InvalidHandle(body));
+        }
+        for collider in self.colliders.attached(body) {
+            self.set_collider_material(collider, material)?;
+        }
+        self.islands
+            .wake(&mut self.bodies, body, &self.settings.sleep);
+        Ok(())
+    }
+
+    /// Sets a body's linear and angular damping (1/s, finite and ≥ 0); wakes it.
+    pub fn set_damping(
+        &mut self,
+        handle: BodyHandle,
+        linear: f32,
+        angular: f32,
+    ) -> Result<(), StepError> {
+        for (field, x) in [("linear_damping", linear), ("angular_damping", angular)] {
+            if !(x.is_finite() && x >= 0.0) {
+                return Err(invalid((
+                    field,
+                    format!("must be finite and >= 0, got {x}"),
+                )));
+            }
+        }
+        let body = self.body_mut_awake(handle)?;
+        body.linear_damping = linear;
+        body.angular_damping = angular;
+        Ok(())
+    }
+
+    /// Gives a dynamic body new mass properties from its shape: a total mass (inertia scaled
+    /// from the shape's at uniform density) or a density, as [`BodyDesc`] takes them. The pose
+    /// and velocities are kept (momentum is not: a heavier body moves as fast as before).
+    /// Refused for a fixed body ([`World::set_fixed`] makes it dynamic) and for limits a scene
+    /// file refuses; wakes the body.
+    pub fn set_mass(&mut self, handle: BodyHandle, mass: MassSpec) -> Result<(), StepError> {
+        let body = self
+            .bodies
+            .get(handle)
+            .ok_or(StepError::InvalidHandle(handle))?;
+        if body.is_fixed() {
+            return Err(invalid((
+                "fixed",
+                "a fixed body has no mass: make it dynamic first (World::set_fixed)".into(),
+            )));
+        }
+        let props = self.shape_mass_of(handle, mass)?;
+        self.body_mut_awake(handle)?
+            .set_mass_properties(props.mass, props.inertia)
+            .map_err(|e| invalid(("mass", e.to_string())))
+    }
+
+    /// Makes a body fixed (immovable, at rest) or dynamic again. A body that was dynamic
+    /// becomes dynamic with the mass properties (and rotation lock) it had; one added fixed
+    /// gets its shape's at [`crate::body_desc::DEFAULT_DENSITY`] (change them with
+    /// [`World::set_mass`]), its centre of mass where its shape's is. What it touched wakes;
+    /// a half-space cannot become dynamic.
+    ///
+    /// ```
+    /// use jostle::{BodyDesc, ShapeDesc, Vec3, World, WorldSettings};
+    ///
+    /// let mut world = World::new(WorldSettings::default());
+    /// let shelf = world
+    ///     .add_body(BodyDesc::fixed("shelf", ShapeDesc::Cuboid { half_extents: Vec3::new(1.0, 0.1, 1.0) })
+    ///         .at(Vec3::new(0.0, 2.0, 0.0)))
+    ///     .unwrap();
+    /// world.set_fixed(shelf, false).unwrap(); // the shelf breaks loose and falls
+    /// for _ in 0..30 {
+    ///     world.step(1.0 / 60.0).unwrap();
+    /// }
+    /// assert!(world.body(shelf).unwrap().position.y < 1.0);
+    /// ```
+    pub fn set_fixed(&mut self, handle: BodyHandle, fixed: bool) -> Result<(), StepError> {
+        let body = self
+            .bodies
+            .get(handle)
+            .ok_or(StepError::InvalidHandle(handle))?;
+        if body.is_fixed() == fixed {
+            return Ok(());
+        }
+        let needs_mass = !fixed && !body.has_mass_properties();
+        let colliders = self.colliders.attached(handle);
+        if !fixed
+            && colliders
+                .iter()
+                .any(|&c| self.colliders.get(c).is_some_and(|c| c.is_unbounded()))
+        {
+            return Err(invalid((
+                "fixed",
+                "a half-space has no finite mass: it must stay fixed".into(),
+            )));
+        }
+        self.wake_around(handle);
+        let first_mass = if needs_mass {
+            Some(self.shape_mass_of(handle, MassSpec::Density(DEFAULT_DENSITY))?)
+        } else {
+            None
+        };
+        let body = self
+            .bodies
+            .get_mut(handle)
+            .ok_or(StepError::InvalidHandle(handle))?;
+        if let Some(props) = first_mass {
+            body.set_mass_properties(props.mass, props.inertia)
+                .map_err(|e| invalid(("mass", e.to_string())))?;
+            // The body's origin becomes its centre of mass; its colliders stay where they are.
+            let offset = props.local_com;
+            body.position += body.orientation * offset;
+            for c in &colliders {
+                if let Some(collider) = self.colliders.get_mut(*c) {
+                    let moved =
+                        jostle_collide::Pose::from_translation(-offset) * collider.local_pose();
+                    collider.set_local_pose(moved);
+                }
+            }
+        }
+        let body = self
+            .bodies
+            .get_mut(handle)
+            .ok_or(StepError::InvalidHandle(handle))?;
+        body.set_fixed(fixed)
+            .map_err(|e| invalid(("fixed", e.to_string())))?;
+        if !fixed {
+            body.sleep.motion = 2.0 * self.settings.sleep.threshold;
+        }
+        self.stamp += 1;
+        Ok(())
+    }
+
+    /// Scales the world's gravity on one body (finite: 0 floats, 1 is the default, −1 falls up);
+    /// wakes it.
+    pub fn set_gravity_scale(&mut self, handle: BodyHandle, scale: f32) -> Result<(), StepError> {
+        if !(scale.is_finite() && (scale * self.settings.gravity.length()) <= MAX_GRAVITY) {
+            return Err(invalid((
+                "gravity_scale",
+                format!("must be finite and give at most {MAX_GRAVITY:e} m/s², got {scale}"),
+            )));
+        }
+        self.body_mut_awake(handle)?.gravity_scale = scale;
+        Ok(())
+    }
+
+    /// Sets a body's continuous collision detection mode; wakes it.
+    pub fn set_ccd(&mut self, handle: BodyHandle, mode: CcdMode) -> Result<(), StepError> {
+        self.body_mut_awake(handle)?.ccd = mode;
+        Ok(())
+    }
+
+    /// Allows or forbids a body to sleep; forbidding wakes it (and its island).
+    pub fn set_can_sleep(&mut self, handle: BodyHandle, can_sleep: bool) -> Result<(), StepError> {
+        let body = if can_sleep {
+            self.bodies
+                .get_mut(handle)
+                .ok_or(StepError::InvalidHandle(handle))?
+        } else {
+            self.body_mut_awake(handle)?
+        };
+        body.sleep.can_sleep = can_sleep;
+        Ok(())
+    }
+
+    /// Sets the world's gravity (m/s², finite, at most [`crate::MAX_GRAVITY`]); every
+    /// sleeping body wakes, since what held it may no longer.
+    pub fn set_gravity(&mut self, gravity: Vec3) -> Result<(), StepError> {
+        if !(gravity.is_finite() && gravity.length() <= MAX_GRAVITY) {
+            return Err(invalid((
+                "gravity",
+                format!("must be finite and at most {MAX_GRAVITY:e} m/s², got {gravity}"),
+            )));
+        }
+        self.settings.gravity = gravity;
+        self.wake_all();
+        Ok(())
+    }
+
+    /// Replaces the resolver by a validated choice with its settings (its state, the warm
+    /// start included, starts afresh; the contacts keep their carried impulses). Unlike
+    /// [`World::set_resolver`], the choice is recorded in the settings, so snapshots carry it.
+    /// Every body wakes.
+    pub fn set_resolver_choice(&mut self, choice: ResolverChoice) -> Result<(), StepError> {
+        choice
+            .validate()
+            .map_err(|(field, message)| StepError::Invalid {
+                field: format!("resolver.{field}"),
+                message,
+            })?;
+        self.resolver = choice.build();
+        self.settings.resolver = choice;
+        self.wake_all();
+        Ok(())
+    }
+
+    /// Wakes every sleeping body.
+    fn wake_all(&mut self) {
+        let handles: Vec<BodyHandle> = self.bodies.iter().map(|(h, _)| h).collect();
+        for h in handles {
+            self.islands.wake(&mut self.bodies, h, &self.settings.sleep);
+        }
+    }
+
+    /// The mass properties of a body's shape given as `mass` (its one collider's
+    /// description).
+    fn shape_mass_of(
+        &self,
+        handle: BodyHandle,
+        mass: MassSpec,
+    ) -> Result<jostle_collide::MassProps, StepError> {
+        let colliders = self.colliders.attached(handle);
+        let [collider] = colliders.as_slice() else {
+            return Err(invalid((
+                "shape",
+                format!(
+                    "mass properties need exactly one collider, the body has {}",
+                    colliders.len()
+                ),
+            )));
+        };
+        let desc = self
+            .colliders
+            .get(*collider)
+            .and_then(|c| c.desc())
+            .ok_or(StepError::InvalidCollider(*collider))?;
+        shape_mass(desc, mass).map_err(|(field, message)| StepError::Invalid { field, message })
+    }
+
     /// Simulated time (s) and steps taken.
     pub fn time(&self) -> (f64, u64) {
         (self.time, self.steps)
@@ -529,7 +802,7 @@ impl World {
     /// The scene queries at the bodies' current poses: rays (first hit and all hits), shape
     /// casts, point projection and shape overlap, each with a [`QueryFilter`].
     ///
-    /// After [`World::update_queries`], and until the next step, added body or pose set, they run
+    /// After [`World::update_queries`], and until the next step, added or removed body or pose set, they run
     /// through the broad phase's tree: a ray among 10,000 colliders costs about what it costs
     /// among 100 (`cargo bench --bench queries`). Otherwise every collider is tested: the same
     /// results, at a cost that grows with the collider count. So call `update_queries` once
@@ -560,7 +833,7 @@ impl World {
     }
 
     /// Brings the broad phase's tree up to the bodies' current poses, so that
-    /// [`World::queries`] run through it until the next step, added body or pose set. Costs about
+    /// [`World::queries`] run through it until the next step, added or removed body or pose set. Costs about
     /// what the broad phase's own pose check costs at the start of a step (one comparison per
     /// collider, a tree update per collider that moved out of its box); changes no result of
     /// any later step (tested).
@@ -572,7 +845,7 @@ impl World {
     }
 
     /// Whether [`World::queries`] run through the tree now ([`World::update_queries`] was
-    /// called since the last step, added body or pose set).
+    /// called since the last step, added or removed body or pose set).
     pub fn queries_use_tree(&self) -> bool {
         self.query_stamp == self.stamp
     }
@@ -619,6 +892,7 @@ impl World {
             &mut self.bodies,
             self.narrow.contacts(),
             dt,
+            self.settings.gravity,
             &mut self.scratch,
             &mut report,
         );

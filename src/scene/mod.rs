@@ -18,7 +18,8 @@
 //! (0, −9.81, 0), `dt` 1/60 s, `steps` 600, `resolver` the soft step at its defaults, `sleep` enabled with
 //! threshold 0.3; body `name` "", `position` origin, `rotation` identity (x, y, z, w), zero
 //! velocities, `density` 1000 kg/m³ unless `mass` (kg) is given, `friction` 0.5 (static;
-//! `dynamic_friction`, at most that, defaults to it), `restitution` 0, damping 0, `can_sleep` true, `fixed` false, `ccd` Auto. `generators` add many bodies
+//! `dynamic_friction`, at most that, defaults to it), `restitution` 0, `friction_combine` and
+//! `restitution_combine` none (geometric mean and max), damping 0, `can_sleep` true, `fixed` false, `ccd` Auto. `generators` add many bodies
 //! from a few parameters (pyramids, stacks, walls, grids of piles); an optional `perturb`
 //! ([`Perturb`]) shifts and turns them a little from a seed, so a file gives a reproducible
 //! perturbed start. An optional `camera`
@@ -203,6 +204,15 @@ pub struct BodySpec {
     /// Restitution e in [0, 1]. Default 0.
     #[serde(default)]
     pub restitution: f32,
+    /// How this body's friction combines with another's at a contact (`GeometricMean`,
+    /// `Average`, `Min`, `Multiply`, `Max`). Default: the geometric mean, unless the other
+    /// body names a rule ([`jostle_collide::Combine::of_pair`]).
+    #[serde(default)]
+    pub friction_combine: Option<jostle_collide::Combine>,
+    /// How this body's restitution combines with another's. Default: the larger, unless the
+    /// other body names a rule.
+    #[serde(default)]
+    pub restitution_combine: Option<jostle_collide::Combine>,
     /// Linear damping (1/s). Default 0.
     #[serde(default)]
     pub linear_damping: f32,
@@ -254,6 +264,8 @@ impl BodySpec {
                 friction: self.friction,
                 restitution: self.restitution,
                 dynamic_friction: self.dynamic_friction,
+                friction_combine: self.friction_combine,
+                restitution_combine: self.restitution_combine,
             },
             linear_damping: self.linear_damping,
             angular_damping: self.angular_damping,

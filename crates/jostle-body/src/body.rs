@@ -97,12 +97,36 @@ pub struct RigidBody {
     force: Vec3,
     torque: Vec3,
     fixed: bool,
+    /// Whether the body's rotation was locked when it was made fixed
+    /// ([`RigidBody::set_fixed`]), so that it is locked again when it becomes dynamic.
+    #[cfg_attr(feature = "serde", serde(default))]
+    locked_while_fixed: bool,
+    /// Scale of the world's gravity on this body (dimensionless; 1 by default, 0 floats, −1
+    /// falls up).
+    #[cfg_attr(feature = "serde", serde(default = "one"))]
+    pub gravity_scale: f32,
+}
+
+#[cfg(feature = "serde")]
+fn one() -> f32 {
+    1.0
 }
 
 impl RigidBody {
     /// A dynamic body of `mass` kg with body-space inertia tensor `inertia` (kg·m²), at the
     /// origin, at rest. Errors on a non-finite or non-positive mass or inertia.
     pub fn dynamic(mass: f32, inertia: Mat3) -> Result<Self, MassError> {
+        let mut body = Self::fixed();
+        body.fixed = false;
+        body.set_mass_properties(mass, inertia)?;
+        Ok(body)
+    }
+
+    /// Gives a dynamic body a new mass (kg) and body-space inertia tensor (kg·m²), keeping its
+    /// pose, velocities and a rotation lock; a fixed body keeps them for when it becomes
+    /// dynamic again ([`RigidBody::set_fixed`]). Errors, changing nothing, on a non-finite or
+    /// non-positive mass or inertia.
+    pub fn set_mass_properties(&mut self, mass: f32, inertia: Mat3) -> Result<(), MassError> {
         if !(mass.is_finite() && mass > 0.0) {
             return Err(MassError::Mass(mass));
         }
@@ -125,14 +149,49 @@ impl RigidBody {
                 return Err(MassError::Inertia(diag));
             }
         }
-        let mut body = Self::fixed();
-        body.fixed = false;
-        body.mass = mass;
-        body.inv_mass = 1.0 / mass;
-        body.inertia_body = inertia;
-        body.inv_inertia_body = inv_inertia;
-        body.update_world_inertia();
-        Ok(body)
+        self.mass = mass;
+        self.inertia_body = inertia;
+        if self.fixed {
+            return Ok(());
+        }
+        let locked = self.is_rotation_locked() && self.inv_mass > 0.0;
+        self.inv_mass = 1.0 / mass;
+        self.inv_inertia_body = if locked { Mat3::ZERO } else { inv_inertia };
+        self.update_world_inertia();
+        Ok(())
+    }
+
+    /// Makes the body fixed (immovable: at rest, no inverse mass or inertia, its forces
+    /// cleared) or dynamic again, with the mass properties it had (and its rotation lock).
+    /// Errors, changing nothing, when a body that was never dynamic has no mass properties to
+    /// become dynamic with: give them first with [`RigidBody::set_mass_properties`].
+    pub fn set_fixed(&mut self, fixed: bool) -> Result<(), MassError> {
+        if fixed == self.fixed {
+            return Ok(());
+        }
+        if fixed {
+            self.locked_while_fixed = self.is_rotation_locked();
+            self.fixed = true;
+            self.inv_mass = 0.0;
+            self.inv_inertia_body = Mat3::ZERO;
+            self.linear_velocity = Vec3::ZERO;
+            self.angular_velocity = Vec3::ZERO;
+            self.last_acceleration = Vec3::ZERO;
+            self.clear_forces();
+            self.update_world_inertia();
+            return Ok(());
+        }
+        let (mass, inertia) = (self.mass, self.inertia_body);
+        let mut dynamic = self.clone();
+        dynamic.fixed = false;
+        dynamic.set_mass_properties(mass, inertia)?;
+        if self.locked_while_fixed {
+            dynamic.lock_rotation();
+        }
+        dynamic.locked_while_fixed = false;
+        dynamic.sleep.awake = true;
+        *self = dynamic;
+        Ok(())
     }
 
     /// An immovable body (infinite mass and inertia) at the origin.
@@ -156,6 +215,8 @@ impl RigidBody {
             force: Vec3::ZERO,
             torque: Vec3::ZERO,
             fixed: true,
+            locked_while_fixed: false,
+            gravity_scale: 1.0,
         }
     }
 
@@ -192,7 +253,13 @@ impl RigidBody {
 
     /// Mass (kg); infinite for a fixed body.
     pub fn mass(&self) -> f32 {
-        self.mass
+        if self.fixed { f32::INFINITY } else { self.mass }
+    }
+
+    /// Whether the body has (or, fixed, keeps) finite mass properties: false for a body that
+    /// was never dynamic ([`RigidBody::fixed`]).
+    pub fn has_mass_properties(&self) -> bool {
+        self.mass.is_finite() && self.inertia_body != Mat3::ZERO
     }
 
     /// 1/mass (1/kg); zero for a fixed body.
@@ -270,6 +337,12 @@ impl RigidBody {
         non_negative("linear_damping", self.linear_damping)?;
         non_negative("angular_damping", self.angular_damping)?;
         non_negative("sleep.motion", self.sleep.motion)?;
+        if !self.gravity_scale.is_finite() {
+            return Err((
+                "gravity_scale",
+                format!("must be finite, got {}", self.gravity_scale),
+            ));
+        }
         let finite = |m: &Mat3| m.to_cols_array().iter().all(|x| x.is_finite());
         if self.fixed {
             if self.inv_mass != 0.0 || self.inv_inertia_body != Mat3::ZERO {
@@ -390,7 +463,9 @@ impl RigidBody {
     pub fn freeze(&mut self) {
         let (position, orientation, sleep) = (self.position, self.orientation, self.sleep);
         let name = std::mem::take(&mut self.name);
-        *self = Self::fixed().with_pose(position, orientation).with_name(name);
+        *self = Self::fixed()
+            .with_pose(position, orientation)
+            .with_name(name);
         self.sleep = SleepState {
             awake: false,
             ..sleep

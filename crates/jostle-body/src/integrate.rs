@@ -24,7 +24,8 @@ pub fn apply_forces(body: &mut RigidBody, dt: f32) {
     }
 }
 
-/// One semi-implicit Euler step of a free body: forces and damping, then gravity into the
+/// One semi-implicit Euler step of a free body: forces and damping, then gravity (times the
+/// body's `gravity_scale`) into the
 /// velocity, then the velocity into the pose; records `last_acceleration` and refreshes the
 /// world inverse inertia. Fixed bodies are left alone.
 pub fn integrate_body(body: &mut RigidBody, gravity: Vec3, dt: f32) {
@@ -32,6 +33,7 @@ pub fn integrate_body(body: &mut RigidBody, gravity: Vec3, dt: f32) {
         return;
     }
     apply_forces(body, dt);
+    let gravity = gravity * body.gravity_scale;
     body.linear_velocity += gravity * dt;
     body.last_acceleration = gravity + body.force() * body.inv_mass();
     body.position += body.linear_velocity * dt;

@@ -30,7 +30,7 @@ pub use ccd::{CcdHit, CcdShape, sweep};
 pub use collider::{Collider, ColliderHandle, ColliderSet, body_pose};
 pub use display::DisplayMesh;
 pub use mass::{MassProps, mass_properties};
-pub use material::Material;
+pub use material::{Combine, Material};
 pub use narrow_phase::{BodyContact, CollisionEvent, NarrowPhase, NarrowStats};
 pub use parry3d;
 pub use parry3d::math::Pose;
