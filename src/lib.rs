@@ -40,7 +40,7 @@ pub use body_desc::{
     BodyDesc, BodyError, MAX_ANGULAR_SPEED, MAX_DENSITY, MAX_DT, MAX_GRAVITY, MAX_MASS,
     MAX_POSITION, MAX_SPEED, MassSpec,
 };
-pub use jostle_body::{BodyHandle, CcdMode, RigidBody};
+pub use jostle_body::{BodyHandle, BodyType, CcdMode, RigidBody};
 pub use jostle_collide::{
     BodyContact, CollideSettings, CollisionEvent, Combine, DisplayMesh, Material, PointHit, Pose,
     Queries, QueryFilter, RayHit, ShapeDesc, ShapeHit, SharedShape,

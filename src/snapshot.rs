@@ -211,7 +211,7 @@ mod file {
             MAX_ANGULAR_SPEED,
             "rad/s",
         )?;
-        if !body.is_fixed() {
+        if !body.is_immovable() {
             check("mass", body.mass(), MAX_MASS, "kg")?;
             let dt = if dt.is_finite() && dt > 0.0 { dt } else { 1.0 };
             let speed_change = body.force().length() * body.inv_mass() * dt;

@@ -39,6 +39,8 @@ pub(crate) struct Scratch {
     /// For each narrow-phase contact whose materials have a dynamic friction coefficient of
     /// their own, whether it is sliding ([`sliding`]); empty when none has.
     pub sliding: Vec<bool>,
+    /// Position-based kinematic bodies and the pose each reaches at the end of this step.
+    pub kinematic_targets: Vec<(jostle_body::BodyHandle, Vec3, jostle_math::Quat)>,
 }
 
 /// Relative tangential speed (m/s) at a contact, at the end of the last step, above which the
@@ -96,7 +98,17 @@ pub(crate) fn wake_touching(
         let (Some(a), Some(b)) = (bodies.get(c.a), bodies.get(c.b)) else {
             continue;
         };
-        if a.is_fixed() || b.is_fixed() || a.sleep.awake == b.sleep.awake {
+        if a.is_immovable() || b.is_immovable() {
+            // Only a moving kinematic body wakes what it touches.
+            let sleeper = match (a.kinematic_moves(), b.kinematic_moves()) {
+                (true, false) if !b.is_immovable() && !b.sleep.awake => c.b,
+                (false, true) if !a.is_immovable() && !a.sleep.awake => c.a,
+                _ => continue,
+            };
+            woke |= islands.wake(bodies, sleeper, settings);
+            continue;
+        }
+        if a.sleep.awake == b.sleep.awake {
             continue;
         }
         let sleeper = if a.sleep.awake { c.b } else { c.a };
@@ -135,7 +147,31 @@ pub(crate) fn gather(
     scratch
         .solver_index
         .resize(bodies.capacity_index(), NO_SOLVER);
+    scratch.kinematic_targets.clear();
     for (handle, body) in bodies.iter_mut() {
+        if body.is_kinematic() {
+            if let Some((position, orientation)) = body.take_next_pose(dt) {
+                scratch
+                    .kinematic_targets
+                    .push((handle, position, orientation));
+            }
+            if !body.kinematic_moves() {
+                // At rest this step: it acts as a fixed body.
+                continue;
+            }
+            // Moved by its velocity alone: no mass, no inertia, no gravity, no forces.
+            scratch.solver_index[handle.index() as usize] = scratch.bodies.len() as u32;
+            scratch.body_slot.push(handle.index());
+            let mut sb = SolverBody::new(body.position, body.orientation, 0.0, Mat3::ZERO);
+            sb.linear_velocity = body.linear_velocity;
+            sb.angular_velocity = body.angular_velocity;
+            if body.angular_velocity != Vec3::ZERO {
+                // Its angular terms are zero (no inverse inertia), but its pose turns.
+                sb.flags |= SolverBody::ROTATES;
+            }
+            scratch.bodies.push(sb);
+            continue;
+        }
         if !body.is_awake() {
             continue;
         }
@@ -171,7 +207,9 @@ pub(crate) fn gather(
     scratch.contact_source.clear();
     let index_of = |h: jostle_body::BodyHandle| -> Option<u32> {
         let body = bodies.get(h)?;
-        if body.is_fixed() {
+        let resting_kinematic =
+            body.is_kinematic() && scratch.solver_index[h.index() as usize] == NO_SOLVER;
+        if body.is_fixed() || resting_kinematic {
             Some(STATIC_BODY)
         } else {
             let i = scratch.solver_index[h.index() as usize];
@@ -183,6 +221,11 @@ pub(crate) fn gather(
             continue;
         };
         if a == STATIC_BODY && b == STATIC_BODY {
+            continue;
+        }
+        // Nothing to resolve between two bodies that nothing can push (kinematic ones).
+        if scratch.bodies[a as usize].inv_mass == 0.0 && scratch.bodies[b as usize].inv_mass == 0.0
+        {
             continue;
         }
         // Static friction holds a contact that is not sliding; a sliding one feels the
@@ -392,7 +435,7 @@ fn sweep_motion(
     scratch: &Scratch,
 ) -> Option<(u32, f32)> {
     let body = bodies.get(collider.body)?;
-    if !body.is_awake() || body.ccd == CcdMode::Off {
+    if !body.is_awake() || body.is_immovable() || body.ccd == CcdMode::Off {
         return None;
     }
     let solver = scratch.solver_index[collider.body.index() as usize];
@@ -545,6 +588,14 @@ pub(crate) fn scatter(
         body.last_acceleration = solver.last_acceleration;
         body.update_world_inertia();
     }
+    // Position-based kinematic bodies end exactly where they were sent.
+    for &(handle, position, orientation) in &scratch.kinematic_targets {
+        if let Some(body) = bodies.get_mut(handle) {
+            body.position = position;
+            body.orientation = orientation;
+            body.update_world_inertia();
+        }
+    }
     for (_, body) in bodies.iter_mut() {
         body.clear_forces();
     }
@@ -566,10 +617,16 @@ pub(crate) fn sleep(
 ) {
     // With sleeping disabled no island can go to sleep, so none is looked for (bodies that
     // fell asleep before it was disabled keep their islands, which still wake together).
+    // A kinematic body is awake while it moves; it never joins an island.
+    for (_, body) in bodies.iter_mut() {
+        if body.is_kinematic() {
+            body.sleep.awake = body.kinematic_moves();
+        }
+    }
     if settings.enabled {
         let mut qualifies = vec![false; bodies.capacity_index()];
         for (h, body) in bodies.iter_mut() {
-            if body.is_awake() {
+            if body.is_awake() && !body.is_kinematic() {
                 qualifies[h.index() as usize] = update_motion(body, settings, dt);
             }
         }
@@ -577,7 +634,7 @@ pub(crate) fn sleep(
         p.islands_count = islands.awake_islands();
     }
     for (_, body) in bodies.iter() {
-        if !body.is_fixed() {
+        if !body.is_immovable() {
             if body.sleep.awake {
                 p.awake_bodies += 1;
             } else {

@@ -11,7 +11,7 @@ use crate::body_desc::{
 use crate::profile::StepProfile;
 use crate::settings::{ResolverChoice, WorldSettings};
 use crate::stages::{self, Scratch};
-use jostle_body::{BodyHandle, BodySet, CcdMode, RigidBody};
+use jostle_body::{BodyHandle, BodySet, BodyType, CcdMode, RigidBody};
 use jostle_collide::{
     BodyContact, BroadPhase, Collider, ColliderHandle, ColliderSet, CollisionEvent, Material,
     NarrowPhase, Queries, QueryFilter, RayHit,
@@ -549,11 +549,8 @@ impl World {
             .map_err(|e| invalid(("mass", e.to_string())))
     }
 
-    /// Makes a body fixed (immovable, at rest) or dynamic again. A body that was dynamic
-    /// becomes dynamic with the mass properties (and rotation lock) it had; one added fixed
-    /// gets its shape's at [`crate::body_desc::DEFAULT_DENSITY`] (change them with
-    /// [`World::set_mass`]), its centre of mass where its shape's is. What it touched wakes;
-    /// a half-space cannot become dynamic.
+    /// Makes a body fixed (immovable, at rest) or dynamic again:
+    /// [`World::set_body_type`] with [`BodyType::Fixed`] or [`BodyType::Dynamic`].
     ///
     /// ```
     /// use jostle::{BodyDesc, ShapeDesc, Vec3, World, WorldSettings};
@@ -570,31 +567,69 @@ impl World {
     /// assert!(world.body(shelf).unwrap().position.y < 1.0);
     /// ```
     pub fn set_fixed(&mut self, handle: BodyHandle, fixed: bool) -> Result<(), StepError> {
+        self.set_body_type(
+            handle,
+            if fixed {
+                BodyType::Fixed
+            } else {
+                BodyType::Dynamic
+            },
+        )
+    }
+
+    /// Changes what moves a body ([`BodyType`]): dynamic, fixed, or kinematic, moved by the
+    /// velocity it is given ([`World::set_velocity`]) or to the pose it is sent to
+    /// ([`World::set_next_pose`]), pushing dynamic bodies and pushed by nothing (forces and
+    /// impulses on it are ignored, and gravity does not act on it). A body that was dynamic
+    /// becomes dynamic again with the mass properties (and rotation lock) it had; one added
+    /// fixed gets its shape's at [`crate::body_desc::DEFAULT_DENSITY`] (change them with
+    /// [`World::set_mass`]), its centre of mass where its shape's is. A kinematic body keeps
+    /// its velocity, a fixed one comes to rest. What it touched wakes; a half-space stays
+    /// fixed.
+    ///
+    /// ```
+    /// use jostle::{BodyDesc, BodyType, ShapeDesc, Vec3, World, WorldSettings};
+    ///
+    /// let mut world = World::new(WorldSettings::default());
+    /// let half = Vec3::new(2.0, 0.1, 2.0);
+    /// let lift = world.add_body(BodyDesc::dynamic("lift", ShapeDesc::Cuboid { half_extents: half })).unwrap();
+    /// world.set_body_type(lift, BodyType::KinematicVelocity).unwrap();
+    /// world.set_velocity(lift, Vec3::new(0.0, 1.0, 0.0), Vec3::ZERO).unwrap();
+    /// for _ in 0..60 {
+    ///     world.step(1.0 / 60.0).unwrap();
+    /// }
+    /// // Gravity does not act on it: one second at 1 m/s up.
+    /// assert!((world.body(lift).unwrap().position.y - 1.0).abs() < 1e-4);
+    /// ```
+    pub fn set_body_type(
+        &mut self,
+        handle: BodyHandle,
+        body_type: BodyType,
+    ) -> Result<(), StepError> {
         let body = self
             .bodies
             .get(handle)
             .ok_or(StepError::InvalidHandle(handle))?;
-        if body.is_fixed() == fixed {
+        if body.body_type() == body_type {
             return Ok(());
         }
-        let needs_mass = !fixed && !body.has_mass_properties();
+        let needs_mass = body_type == BodyType::Dynamic && !body.has_mass_properties();
         let colliders = self.colliders.attached(handle);
-        if !fixed
-            && colliders
-                .iter()
-                .any(|&c| self.colliders.get(c).is_some_and(|c| c.is_unbounded()))
-        {
+        let unbounded = colliders
+            .iter()
+            .any(|&c| self.colliders.get(c).is_some_and(|c| c.is_unbounded()));
+        if body_type != BodyType::Fixed && unbounded {
             return Err(invalid((
-                "fixed",
-                "a half-space has no finite mass: it must stay fixed".into(),
+                "body_type",
+                "a half-space has no finite mass or bounds: it must stay fixed".into(),
             )));
         }
-        self.wake_around(handle);
         let first_mass = if needs_mass {
             Some(self.shape_mass_of(handle, MassSpec::Density(DEFAULT_DENSITY))?)
         } else {
             None
         };
+        self.wake_around(handle);
         let body = self
             .bodies
             .get_mut(handle)
@@ -617,12 +652,52 @@ impl World {
             .bodies
             .get_mut(handle)
             .ok_or(StepError::InvalidHandle(handle))?;
-        body.set_fixed(fixed)
-            .map_err(|e| invalid(("fixed", e.to_string())))?;
-        if !fixed {
+        body.set_body_type(body_type)
+            .map_err(|e| invalid(("body_type", e.to_string())))?;
+        if body_type == BodyType::Dynamic {
             body.sleep.motion = 2.0 * self.settings.sleep.threshold;
         }
+        body.sleep.awake = match body_type {
+            BodyType::Fixed => false,
+            BodyType::Dynamic => true,
+            _ => body.kinematic_moves(),
+        };
         self.stamp += 1;
+        Ok(())
+    }
+
+    /// Sends a position-based kinematic body ([`BodyType::KinematicPosition`]) to a pose,
+    /// which it reaches at the end of the next step, moving at the velocity that takes it
+    /// there (so that what it pushes or carries moves with it). Without a new pose it stays
+    /// where it is. Refused for other bodies; wakes what it touches.
+    pub fn set_next_pose(
+        &mut self,
+        handle: BodyHandle,
+        position: Vec3,
+        rotation: Quat,
+    ) -> Result<(), StepError> {
+        Self::finite("position", position)?;
+        let Some(unit) = unit_rotation(rotation) else {
+            return Err(StepError::NonFinite {
+                what: "rotation",
+                value: format!("{rotation:?}"),
+            });
+        };
+        let body = self
+            .bodies
+            .get_mut(handle)
+            .ok_or(StepError::InvalidHandle(handle))?;
+        if body.body_type() != BodyType::KinematicPosition {
+            return Err(invalid((
+                "body_type",
+                format!(
+                    "a next pose is for a KinematicPosition body, this one is {:?}",
+                    body.body_type()
+                ),
+            )));
+        }
+        body.set_next_pose(position, unit);
+        body.sleep.awake = true;
         Ok(())
     }
 

@@ -208,7 +208,10 @@ fn bodies_switch_between_fixed_and_dynamic() {
 
     // A half-space stays fixed.
     let g = world.find_body("ground").unwrap();
-    assert_eq!(field_of(world.set_fixed(g, false).unwrap_err()), "fixed");
+    assert_eq!(
+        field_of(world.set_fixed(g, false).unwrap_err()),
+        "body_type"
+    );
 }
 
 /// Positions after one second of free fall under gravity scaled by s: s times the fall of

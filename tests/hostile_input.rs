@@ -208,7 +208,7 @@ fn a_snapshot_names_the_body_or_collider_and_the_field_it_refuses() {
     let cases = [
         ("mass: 999", "inv_mass: ", "-0.5", "`inv_mass`"),
         (
-            "fixed: true",
+            "body_type: Fixed",
             "linear_velocity: ",
             "1e30",
             "`linear_velocity`",
@@ -219,7 +219,7 @@ fn a_snapshot_names_the_body_or_collider_and_the_field_it_refuses() {
             "99.0",
             "`inv_inertia_body`",
         ),
-        ("bodies:", "inv_mass: ", "1.0", "`fixed`"),
+        ("bodies:", "inv_mass: ", "1.0", "`body_type`"),
         ("colliders:", "restitution: ", "5.0", "restitution"),
         ("resolver:", "substeps: ", "4294967", "substeps"),
         ("narrow:", "impulse: ", "NaN", "impulse"),

@@ -54,6 +54,23 @@ pub enum CcdMode {
     Off,
 }
 
+/// What moves a body.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum BodyType {
+    /// Moved by gravity, forces and contacts.
+    #[default]
+    Dynamic,
+    /// Never moves (the ground, walls).
+    Fixed,
+    /// Moves with the velocity the user sets; pushes dynamic bodies, is pushed by nothing.
+    KinematicVelocity,
+    /// Moves to the pose the user sets for the end of each step
+    /// ([`RigidBody::set_next_pose`], the velocity derived from it); pushes dynamic bodies, is
+    /// pushed by nothing. Without a next pose it stays where it is.
+    KinematicPosition,
+}
+
 /// A rigid body: mass properties, pose, velocities, damping, accumulated force and torque,
 /// the acceleration of the last step, and sleep state.
 ///
@@ -96,11 +113,15 @@ pub struct RigidBody {
     inv_inertia_world: Mat3,
     force: Vec3,
     torque: Vec3,
-    fixed: bool,
-    /// Whether the body's rotation was locked when it was made fixed
-    /// ([`RigidBody::set_fixed`]), so that it is locked again when it becomes dynamic.
+    body_type: BodyType,
+    /// Whether the body's rotation was locked when it stopped being dynamic
+    /// ([`RigidBody::set_body_type`]), so that it is locked again when it becomes dynamic.
     #[cfg_attr(feature = "serde", serde(default))]
     locked_while_fixed: bool,
+    /// The pose a position-based kinematic body is to reach at the end of the next step
+    /// ([`RigidBody::set_next_pose`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    next_pose: Option<(Vec3, Quat)>,
     /// Scale of the world's gravity on this body (dimensionless; 1 by default, 0 floats, −1
     /// falls up).
     #[cfg_attr(feature = "serde", serde(default = "one"))]
@@ -117,7 +138,7 @@ impl RigidBody {
     /// origin, at rest. Errors on a non-finite or non-positive mass or inertia.
     pub fn dynamic(mass: f32, inertia: Mat3) -> Result<Self, MassError> {
         let mut body = Self::fixed();
-        body.fixed = false;
+        body.body_type = BodyType::Dynamic;
         body.set_mass_properties(mass, inertia)?;
         Ok(body)
     }
@@ -151,7 +172,7 @@ impl RigidBody {
         }
         self.mass = mass;
         self.inertia_body = inertia;
-        if self.fixed {
+        if self.body_type != BodyType::Dynamic {
             return Ok(());
         }
         let locked = self.is_rotation_locked() && self.inv_mass > 0.0;
@@ -162,20 +183,38 @@ impl RigidBody {
     }
 
     /// Makes the body fixed (immovable: at rest, no inverse mass or inertia, its forces
-    /// cleared) or dynamic again, with the mass properties it had (and its rotation lock).
-    /// Errors, changing nothing, when a body that was never dynamic has no mass properties to
-    /// become dynamic with: give them first with [`RigidBody::set_mass_properties`].
+    /// cleared) or dynamic again: [`RigidBody::set_body_type`] with [`BodyType::Fixed`] or
+    /// [`BodyType::Dynamic`].
     pub fn set_fixed(&mut self, fixed: bool) -> Result<(), MassError> {
-        if fixed == self.fixed {
+        self.set_body_type(if fixed {
+            BodyType::Fixed
+        } else {
+            BodyType::Dynamic
+        })
+    }
+
+    /// Changes the body's type. A body that stops being dynamic keeps its mass properties (and
+    /// rotation lock) for when it becomes dynamic again; a fixed body comes to rest, a
+    /// kinematic one keeps its velocities (and moves with them until told otherwise). Forces
+    /// are cleared. Errors, changing nothing, when a body that was never dynamic has no mass
+    /// properties to become dynamic with: give them first with
+    /// [`RigidBody::set_mass_properties`].
+    pub fn set_body_type(&mut self, body_type: BodyType) -> Result<(), MassError> {
+        if body_type == self.body_type {
             return Ok(());
         }
-        if fixed {
-            self.locked_while_fixed = self.is_rotation_locked();
-            self.fixed = true;
+        if body_type != BodyType::Dynamic {
+            if self.body_type == BodyType::Dynamic {
+                self.locked_while_fixed = self.is_rotation_locked();
+            }
+            self.body_type = body_type;
             self.inv_mass = 0.0;
             self.inv_inertia_body = Mat3::ZERO;
-            self.linear_velocity = Vec3::ZERO;
-            self.angular_velocity = Vec3::ZERO;
+            if body_type == BodyType::Fixed {
+                self.linear_velocity = Vec3::ZERO;
+                self.angular_velocity = Vec3::ZERO;
+            }
+            self.next_pose = None;
             self.last_acceleration = Vec3::ZERO;
             self.clear_forces();
             self.update_world_inertia();
@@ -183,15 +222,79 @@ impl RigidBody {
         }
         let (mass, inertia) = (self.mass, self.inertia_body);
         let mut dynamic = self.clone();
-        dynamic.fixed = false;
+        dynamic.body_type = BodyType::Dynamic;
+        dynamic.inv_mass = 0.0;
         dynamic.set_mass_properties(mass, inertia)?;
         if self.locked_while_fixed {
             dynamic.lock_rotation();
         }
         dynamic.locked_while_fixed = false;
+        dynamic.next_pose = None;
         dynamic.sleep.awake = true;
         *self = dynamic;
         Ok(())
+    }
+
+    /// The body's type.
+    pub fn body_type(&self) -> BodyType {
+        self.body_type
+    }
+
+    /// Whether the body is kinematic (moved by its velocity or its next pose, pushed by
+    /// nothing).
+    pub fn is_kinematic(&self) -> bool {
+        matches!(
+            self.body_type,
+            BodyType::KinematicVelocity | BodyType::KinematicPosition
+        )
+    }
+
+    /// Whether nothing can push the body: it is fixed or kinematic.
+    pub fn is_immovable(&self) -> bool {
+        self.body_type != BodyType::Dynamic
+    }
+
+    /// Whether a kinematic body moves in the next step (a velocity, or a next pose to reach).
+    pub fn kinematic_moves(&self) -> bool {
+        self.is_kinematic()
+            && (self.next_pose.is_some()
+                || self.linear_velocity != Vec3::ZERO
+                || self.angular_velocity != Vec3::ZERO)
+    }
+
+    /// For a position-based kinematic body: the pose to reach at the end of the next step
+    /// (its velocities for the step are derived from it). Does nothing to other bodies.
+    pub fn set_next_pose(&mut self, position: Vec3, orientation: Quat) {
+        if self.body_type == BodyType::KinematicPosition {
+            self.next_pose = Some((position, orientation.normalize()));
+        }
+    }
+
+    /// The next pose of a position-based kinematic body, taken for the step: sets the
+    /// velocities that reach it in `dt` (zero without one) and returns it, so that the pose
+    /// can be set exactly at the end of the step.
+    pub fn take_next_pose(&mut self, dt: f32) -> Option<(Vec3, Quat)> {
+        if self.body_type != BodyType::KinematicPosition {
+            return None;
+        }
+        let Some((position, orientation)) = self.next_pose.take() else {
+            self.linear_velocity = Vec3::ZERO;
+            self.angular_velocity = Vec3::ZERO;
+            return None;
+        };
+        self.linear_velocity = (position - self.position) / dt;
+        // The rotation from the current orientation to the target, the shorter way round.
+        let mut turn = orientation * self.orientation.inverse();
+        if turn.w < 0.0 {
+            turn = -turn;
+        }
+        let (axis, angle) = turn.to_axis_angle();
+        self.angular_velocity = if angle.is_finite() && angle > 0.0 {
+            axis * (angle / dt)
+        } else {
+            Vec3::ZERO
+        };
+        Some((position, orientation))
     }
 
     /// An immovable body (infinite mass and inertia) at the origin.
@@ -214,8 +317,9 @@ impl RigidBody {
             inv_inertia_world: Mat3::ZERO,
             force: Vec3::ZERO,
             torque: Vec3::ZERO,
-            fixed: true,
+            body_type: BodyType::Fixed,
             locked_while_fixed: false,
+            next_pose: None,
             gravity_scale: 1.0,
         }
     }
@@ -243,17 +347,21 @@ impl RigidBody {
 
     /// Whether the body is immovable.
     pub fn is_fixed(&self) -> bool {
-        self.fixed
+        self.body_type == BodyType::Fixed
     }
 
     /// Whether the body is awake (fixed bodies report `false`: they are never simulated).
     pub fn is_awake(&self) -> bool {
-        !self.fixed && self.sleep.awake
+        !self.is_fixed() && self.sleep.awake
     }
 
     /// Mass (kg); infinite for a fixed body.
     pub fn mass(&self) -> f32 {
-        if self.fixed { f32::INFINITY } else { self.mass }
+        if self.is_immovable() {
+            f32::INFINITY
+        } else {
+            self.mass
+        }
     }
 
     /// Whether the body has (or, fixed, keeps) finite mass properties: false for a body that
@@ -282,7 +390,7 @@ impl RigidBody {
     /// is set to zero. The mass and the stored inertia (for [`RigidBody::kinetic_energy`]) are
     /// kept. Does nothing to a fixed body.
     pub fn lock_rotation(&mut self) {
-        if self.fixed {
+        if self.is_immovable() {
             return;
         }
         self.inv_inertia_body = Mat3::ZERO;
@@ -292,7 +400,7 @@ impl RigidBody {
 
     /// Whether the body's rotation is locked ([`RigidBody::lock_rotation`]).
     pub fn is_rotation_locked(&self) -> bool {
-        !self.fixed && self.inv_inertia_body == Mat3::ZERO
+        self.body_type == BodyType::Dynamic && self.inv_inertia_body == Mat3::ZERO
     }
 
     /// Recomputes the world inverse inertia from the orientation; call after changing
@@ -344,12 +452,12 @@ impl RigidBody {
             ));
         }
         let finite = |m: &Mat3| m.to_cols_array().iter().all(|x| x.is_finite());
-        if self.fixed {
+        if self.is_immovable() {
             if self.inv_mass != 0.0 || self.inv_inertia_body != Mat3::ZERO {
                 return Err((
-                    "fixed",
+                    "body_type",
                     format!(
-                        "a fixed body has no inverse mass or inertia, got inv_mass {}",
+                        "a fixed or kinematic body has no inverse mass or inertia, got inv_mass {}",
                         self.inv_mass
                     ),
                 ));
@@ -451,7 +559,7 @@ impl RigidBody {
     /// world inverse inertia of a needle-like body in f32 lost about 0.1% of its energy, which
     /// the property tests mistook for energy drift.
     pub fn kinetic_energy(&self) -> f32 {
-        if self.fixed {
+        if self.is_immovable() {
             return 0.0;
         }
         let w = self.orientation.inverse() * self.angular_velocity;

@@ -11,7 +11,7 @@ use jostle_math::{Vec3, integrate_orientation};
 /// Applies the accumulated force and torque over `dt` as an impulse (Δv = F/m·dt,
 /// Δω = I⁻¹_world·τ·dt), then damping v ← v/(1 + dt·c). Does not clear the accumulators.
 pub fn apply_forces(body: &mut RigidBody, dt: f32) {
-    if body.is_fixed() {
+    if body.is_immovable() {
         return;
     }
     body.linear_velocity += body.force() * (body.inv_mass() * dt);
@@ -27,9 +27,22 @@ pub fn apply_forces(body: &mut RigidBody, dt: f32) {
 /// One semi-implicit Euler step of a free body: forces and damping, then gravity (times the
 /// body's `gravity_scale`) into the
 /// velocity, then the velocity into the pose; records `last_acceleration` and refreshes the
-/// world inverse inertia. Fixed bodies are left alone.
+/// world inverse inertia. Fixed bodies are left alone; kinematic ones move by their velocity
+/// (or to their next pose) only.
 pub fn integrate_body(body: &mut RigidBody, gravity: Vec3, dt: f32) {
     if body.is_fixed() {
+        return;
+    }
+    if body.is_kinematic() {
+        // Its velocity alone (derived from its next pose, if it has one) moves it.
+        let target = body.take_next_pose(dt);
+        body.position += body.linear_velocity * dt;
+        body.orientation = integrate_orientation(body.orientation, body.angular_velocity * dt);
+        if let Some((position, orientation)) = target {
+            body.position = position;
+            body.orientation = orientation;
+        }
+        body.update_world_inertia();
         return;
     }
     apply_forces(body, dt);

@@ -13,6 +13,6 @@ pub mod integrate;
 pub mod set;
 
 pub use arena::{Arena, ArenaIndex};
-pub use body::{CcdMode, MassError, RigidBody, SleepState};
+pub use body::{BodyType, CcdMode, MassError, RigidBody, SleepState};
 pub use integrate::{apply_forces, integrate_body};
 pub use set::{BodyHandle, BodySet};

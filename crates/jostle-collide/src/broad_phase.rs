@@ -4,7 +4,8 @@
 //! [`ColliderPair`]s whose bounding boxes, each enlarged by a margin, overlap.
 //!
 //! Invariants of the output: at least one of the two bodies is awake (never static–static,
-//! sleeping–sleeping or sleeping–static), never two colliders of the same body, each pair once
+//! sleeping–sleeping or sleeping–static) and one is dynamic (never between fixed and kinematic
+//! bodies), never two colliders of the same body, each pair once
 //! with the lower handle first, sorted by handle pair — so the result is deterministic and is
 //! exactly the set a brute-force all-pairs test of the enlarged boxes gives.
 //!
@@ -47,6 +48,8 @@ struct Proxy {
     generation: u32,
     body: BodyHandle,
     awake: bool,
+    /// Its body is fixed or kinematic: no pair of two such colliders is a candidate.
+    immovable: bool,
     unbounded: bool,
     /// World outward normal of an unbounded (half-space) collider; zero otherwise.
     normal: Vec3,
@@ -280,6 +283,7 @@ impl BroadPhase {
             let pose = collider.world_pose(body);
             let shape_id = shape_id(collider);
             let awake = body.is_awake();
+            let immovable = body.is_immovable();
             let proxy = &mut self.proxies[i as usize];
             let fresh = match proxy {
                 Some(p) => {
@@ -306,6 +310,7 @@ impl BroadPhase {
                     generation: handle.generation(),
                     body: collider.body,
                     awake,
+                    immovable,
                     unbounded,
                     normal,
                     pose,
@@ -319,6 +324,7 @@ impl BroadPhase {
                 continue;
             };
             p.awake = awake;
+            p.immovable = immovable;
             p.body = collider.body;
             if p.unbounded {
                 self.unbounded.push(i);
@@ -482,7 +488,11 @@ impl BroadPhase {
                 else {
                     continue;
                 };
-                if !(pi.awake || pj.awake) || pi.body == pj.body || !pi.aabb.intersects(&pj.aabb) {
+                if !(pi.awake || pj.awake)
+                    || (pi.immovable && pj.immovable)
+                    || pi.body == pj.body
+                    || !pi.aabb.intersects(&pj.aabb)
+                {
                     continue;
                 }
                 self.pairs.push(ColliderPair::new(
@@ -510,7 +520,11 @@ impl BroadPhase {
                     continue;
                 };
                 // Awake–awake pairs are found from both sides: keep the one from the lower slot.
-                if (pj.awake && j < i) || pj.body == pi.body || !pi.aabb.intersects(&pj.aabb) {
+                if (pj.awake && j < i)
+                    || (pi.immovable && pj.immovable)
+                    || pj.body == pi.body
+                    || !pi.aabb.intersects(&pj.aabb)
+                {
                     continue;
                 }
                 self.pairs.push(ColliderPair::new(
@@ -528,7 +542,10 @@ impl BroadPhase {
             };
             let hu = self.handle(u);
             let test = |_j: u32, pj: &Proxy| {
-                pj.body != pu.body && !pj.unbounded && halfspace_overlaps(pu, &pj.aabb, self.margin)
+                pj.body != pu.body
+                    && !pj.unbounded
+                    && !(pu.immovable && pj.immovable)
+                    && halfspace_overlaps(pu, &pj.aabb, self.margin)
             };
             if pu.awake {
                 for (j, pj) in self.proxies.iter().enumerate() {
@@ -551,6 +568,7 @@ impl BroadPhase {
             for &v in &self.unbounded[k + 1..] {
                 if let Some(pv) = &self.proxies[v as usize]
                     && (pu.awake || pv.awake)
+                    && !(pu.immovable && pv.immovable)
                     && pu.body != pv.body
                 {
                     self.pairs

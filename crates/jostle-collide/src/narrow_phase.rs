@@ -509,8 +509,8 @@ impl NarrowPhase {
                 compute(&mut state, c1, c2, &pos12, settings.prediction);
             }
 
-            // A is the dynamic body when the other is fixed; else collider 1's body.
-            let flip = b1.is_fixed() && !b2.is_fixed();
+            // A is the dynamic body when the other is fixed or kinematic; else collider 1's body.
+            let flip = b1.is_immovable() && !b2.is_immovable();
             let (a, b) = if flip {
                 (c2.body, c1.body)
             } else {

@@ -151,7 +151,8 @@ impl IslandSet {
     }
 
     /// After a step: finds the islands of awake bodies joined by `touching` pairs (pairs that
-    /// involve a fixed body are ignored: islands never join through static geometry), and puts
+    /// involve a fixed or kinematic body are ignored: islands never join through static
+    /// geometry or a moving platform, and such bodies are never put to sleep here), and puts
     /// to sleep every island whose bodies all `qualifies` (a slot-indexed table, typically from
     /// [`crate::update_motion`]). Returns the number of bodies put to sleep.
     pub fn update(
@@ -164,7 +165,12 @@ impl IslandSet {
         self.sleeping_of.resize(n, None);
         let mut uf = UnionFind::new(n);
         for (a, b) in touching {
-            let awake = |h: BodyHandle| bodies.get(h).is_some_and(|b| b.is_awake());
+            // Fixed and kinematic bodies never join islands.
+            let awake = |h: BodyHandle| {
+                bodies
+                    .get(h)
+                    .is_some_and(|b| b.is_awake() && !b.is_immovable())
+            };
             if awake(a) && awake(b) {
                 uf.union(a.index(), b.index());
             }
@@ -174,7 +180,7 @@ impl IslandSet {
         let mut is_root = vec![false; n];
         let awake: Vec<(BodyHandle, u32)> = bodies
             .iter()
-            .filter(|(_, b)| b.is_awake())
+            .filter(|(_, b)| b.is_awake() && !b.is_immovable())
             .map(|(h, _)| (h, uf.find(h.index())))
             .collect();
         for &(h, root) in &awake {

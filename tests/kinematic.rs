@@ -1,0 +1,323 @@
+//! Kinematic bodies (issue 19 item 3), with both resolvers: moved by their velocity or sent
+//! to a pose, they carry and push dynamic bodies, nothing pushes them, gravity does not act on
+//! them, and a body's type changes at run time.
+
+mod common;
+
+use jostle::snapshot::Snapshot;
+use jostle::{
+    BodyDesc, BodyType, CollisionEvent, Quat, ResolverChoice, ShapeDesc, Vec3, World, WorldSettings,
+};
+
+const DT: f32 = 1.0 / 60.0;
+
+fn world(resolver: ResolverChoice) -> World {
+    World::new(WorldSettings {
+        resolver,
+        ..Default::default()
+    })
+}
+
+fn boxed(name: &str, half: Vec3, at: Vec3) -> BodyDesc {
+    BodyDesc::dynamic(name, ShapeDesc::Cuboid { half_extents: half })
+        .at(at)
+        .with_density(1000.0)
+}
+
+fn kinematic(
+    world: &mut World,
+    name: &str,
+    half: Vec3,
+    at: Vec3,
+    kind: BodyType,
+) -> jostle::BodyHandle {
+    let h = world.add_body(boxed(name, half, at)).unwrap();
+    world.set_body_type(h, kind).unwrap();
+    h
+}
+
+fn steps(world: &mut World, n: usize) {
+    for _ in 0..n {
+        world.step(DT).unwrap();
+    }
+}
+
+/// A platform moving at 1 m/s carries the box resting on it by friction; it moves exactly as
+/// its velocity says, and stays at its height without gravity acting on it.
+#[test]
+fn a_moving_platform_carries_a_box() {
+    for resolver in common::resolvers() {
+        let name = resolver.name();
+        let mut w = world(resolver);
+        let platform = kinematic(
+            &mut w,
+            "platform",
+            Vec3::new(3.0, 0.25, 3.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            BodyType::KinematicVelocity,
+        );
+        let cargo = w
+            .add_body(
+                boxed("cargo", Vec3::splat(0.25), Vec3::new(0.0, 1.5, 0.0)).with_material(0.8, 0.0),
+            )
+            .unwrap();
+        steps(&mut w, 60);
+        w.set_velocity(platform, Vec3::new(1.0, 0.0, 0.0), Vec3::ZERO)
+            .unwrap();
+        steps(&mut w, 120);
+        let p = w.body(platform).unwrap();
+        assert!(
+            (p.position - Vec3::new(2.0, 1.0, 0.0)).length() < 1e-4,
+            "{name}: the platform moved by its velocity alone: {}",
+            p.position
+        );
+        assert_eq!(
+            p.linear_velocity,
+            Vec3::new(1.0, 0.0, 0.0),
+            "{name}: nothing slowed it"
+        );
+        // The platform starts at once; the cargo slides until friction (μ = sqrt(0.8·0.5),
+        // the materials' geometric mean) has brought it to 1 m/s: v²/(2μg) behind.
+        let lag = 1.0 / (2.0 * (0.8f32 * 0.5).sqrt() * 9.81);
+        let c = w.body(cargo).unwrap();
+        assert!(
+            (c.position.x - (2.0 - lag)).abs() < 0.02 && (c.position.y - 1.5).abs() < 0.01,
+            "{name}: the cargo rode along, {lag} m behind: {}",
+            c.position
+        );
+        assert!(
+            (c.linear_velocity.x - 1.0).abs() < 0.01,
+            "{name}: {}",
+            c.linear_velocity
+        );
+    }
+}
+
+/// A kinematic pusher at 2 m/s pushes a heavy box across frictionless ground and keeps its
+/// speed; a heavy box thrown at a resting kinematic wall does not move it.
+#[test]
+fn kinematic_bodies_push_and_nothing_pushes_them() {
+    for resolver in common::resolvers() {
+        let name = resolver.name();
+        let mut w = world(resolver);
+        w.add_body(
+            BodyDesc::fixed("ground", ShapeDesc::HalfSpace { normal: Vec3::Y })
+                .with_material(0.0, 0.0),
+        )
+        .unwrap();
+        let pusher = kinematic(
+            &mut w,
+            "pusher",
+            Vec3::new(0.5, 0.5, 1.0),
+            Vec3::new(-2.0, 0.5, 0.0),
+            BodyType::KinematicVelocity,
+        );
+        w.set_velocity(pusher, Vec3::new(2.0, 0.0, 0.0), Vec3::ZERO)
+            .unwrap();
+        let crate_ = w
+            .add_body(
+                boxed("crate", Vec3::splat(0.5), Vec3::new(0.5, 0.5, 0.0))
+                    .with_density(10_000.0)
+                    .with_material(0.0, 0.0),
+            )
+            .unwrap();
+        steps(&mut w, 120);
+        let p = w.body(pusher).unwrap();
+        assert!(
+            (p.position.x - 2.0).abs() < 1e-4,
+            "{name}: pusher at {}",
+            p.position
+        );
+        let c = w.body(crate_).unwrap();
+        assert!(
+            c.position.x > p.position.x + 0.95,
+            "{name}: the crate is ahead of the pusher: {} vs {}",
+            c.position.x,
+            p.position.x
+        );
+
+        let wall = kinematic(
+            &mut w,
+            "wall",
+            Vec3::new(0.2, 2.0, 2.0),
+            Vec3::new(20.0, 2.0, 0.0),
+            BodyType::KinematicVelocity,
+        );
+        let ram = w
+            .add_body(
+                boxed("ram", Vec3::splat(0.5), Vec3::new(17.0, 0.5, 0.0))
+                    .with_density(100_000.0)
+                    .moving(Vec3::new(8.0, 0.0, 0.0), Vec3::ZERO),
+            )
+            .unwrap();
+        steps(&mut w, 60);
+        let wall_now = w.body(wall).unwrap();
+        assert_eq!(
+            wall_now.position,
+            Vec3::new(20.0, 2.0, 0.0),
+            "{name}: the wall held"
+        );
+        assert!(
+            w.body(ram).unwrap().position.x < 19.5,
+            "{name}: the ram stopped at the wall"
+        );
+    }
+}
+
+/// A position-based lift sent up 1 cm per step reaches each pose exactly and lifts its load.
+#[test]
+fn a_position_based_lift_reaches_each_pose_and_lifts_its_load() {
+    for resolver in common::resolvers() {
+        let name = resolver.name();
+        let mut w = world(resolver);
+        let lift = kinematic(
+            &mut w,
+            "lift",
+            Vec3::new(1.0, 0.1, 1.0),
+            Vec3::new(0.0, 0.1, 0.0),
+            BodyType::KinematicPosition,
+        );
+        let load = w
+            .add_body(boxed("load", Vec3::splat(0.3), Vec3::new(0.0, 0.5, 0.0)))
+            .unwrap();
+        steps(&mut w, 60);
+        assert_eq!(
+            w.body(lift).unwrap().position.y,
+            0.1,
+            "{name}: it stays without a pose"
+        );
+        for k in 1..=120 {
+            let y = 0.1 + 0.01 * k as f32;
+            let turn = Quat::from_rotation_y(0.005 * k as f32);
+            w.set_next_pose(lift, Vec3::new(0.0, y, 0.0), turn).unwrap();
+            w.step(DT).unwrap();
+            let b = w.body(lift).unwrap();
+            assert_eq!(b.position, Vec3::new(0.0, y, 0.0), "{name}: step {k}");
+            assert!(b.orientation.dot(turn).abs() > 1.0 - 1e-6);
+        }
+        let rest = w.body(load).unwrap().position.y;
+        assert!(
+            (rest - (1.3 + 0.1 + 0.3)).abs() < 0.01,
+            "{name}: load at {rest}"
+        );
+        assert!(w.set_next_pose(load, Vec3::ZERO, Quat::IDENTITY).is_err());
+    }
+}
+
+/// Dynamic to kinematic mid-fall: it keeps its velocity and stops accelerating; back to
+/// dynamic: it falls again with the mass it had.
+#[test]
+fn the_type_changes_at_run_time() {
+    for resolver in common::resolvers() {
+        let name = resolver.name();
+        let mut w = world(resolver);
+        let b = w
+            .add_body(boxed("b", Vec3::splat(0.5), Vec3::new(0.0, 100.0, 0.0)))
+            .unwrap();
+        steps(&mut w, 30);
+        let v = w.body(b).unwrap().linear_velocity;
+        w.set_body_type(b, BodyType::KinematicVelocity).unwrap();
+        steps(&mut w, 30);
+        assert_eq!(
+            w.body(b).unwrap().linear_velocity,
+            v,
+            "{name}: no gravity on it"
+        );
+        w.apply_force(b, Vec3::new(1e6, 0.0, 0.0)).unwrap();
+        steps(&mut w, 1);
+        assert_eq!(
+            w.body(b).unwrap().linear_velocity,
+            v,
+            "{name}: no force either"
+        );
+        w.set_body_type(b, BodyType::Dynamic).unwrap();
+        assert!((w.body(b).unwrap().mass() - 1000.0).abs() < 0.01);
+        steps(&mut w, 30);
+        assert!(
+            w.body(b).unwrap().linear_velocity.y < v.y - 4.0,
+            "{name}: falls again"
+        );
+    }
+}
+
+/// A box resting on a still platform falls asleep; the platform starting to move wakes it.
+/// A kinematic body overlapping the ground makes no contact and no event.
+#[test]
+fn a_still_platform_lets_its_load_sleep_and_a_moving_one_wakes_it() {
+    let mut w = world(ResolverChoice::default());
+    let ground = w
+        .add_body(BodyDesc::fixed(
+            "ground",
+            ShapeDesc::HalfSpace { normal: Vec3::Y },
+        ))
+        .unwrap();
+    let platform = kinematic(
+        &mut w,
+        "platform",
+        Vec3::new(2.0, 0.25, 2.0),
+        Vec3::new(0.0, 0.0, 0.0),
+        BodyType::KinematicVelocity,
+    );
+    let load = w
+        .add_body(boxed("load", Vec3::splat(0.25), Vec3::new(0.0, 0.5, 0.0)))
+        .unwrap();
+    let mut slept = false;
+    for _ in 0..300 {
+        w.step(DT).unwrap();
+        slept |= !w.body(load).unwrap().sleep.awake;
+        let touches_ground = w.events().iter().any(|e| match *e {
+            CollisionEvent::Started(a, b) | CollisionEvent::Stopped(a, b) => {
+                (a, b) == (ground, platform) || (a, b) == (platform, ground)
+            }
+        });
+        assert!(!touches_ground);
+    }
+    assert!(slept, "the load sleeps on a still platform");
+    w.set_velocity(platform, Vec3::new(0.0, 0.5, 0.0), Vec3::ZERO)
+        .unwrap();
+    steps(&mut w, 2);
+    assert!(w.body(load).unwrap().sleep.awake, "and wakes when it moves");
+    steps(&mut w, 60);
+    assert!(
+        w.body(load).unwrap().position.y > 0.9,
+        "{}",
+        w.body(load).unwrap().position.y
+    );
+}
+
+#[test]
+fn kinematic_bodies_round_trip_through_snapshots() {
+    let mut w = world(ResolverChoice::default());
+    let platform = kinematic(
+        &mut w,
+        "platform",
+        Vec3::new(2.0, 0.25, 2.0),
+        Vec3::ZERO,
+        BodyType::KinematicVelocity,
+    );
+    w.set_velocity(platform, Vec3::new(0.3, 0.0, 0.0), Vec3::new(0.0, 0.2, 0.0))
+        .unwrap();
+    let lift = kinematic(
+        &mut w,
+        "lift",
+        Vec3::splat(0.5),
+        Vec3::new(6.0, 0.0, 0.0),
+        BodyType::KinematicPosition,
+    );
+    w.add_body(boxed("load", Vec3::splat(0.25), Vec3::new(0.0, 0.5, 0.0)))
+        .unwrap();
+    steps(&mut w, 20);
+    w.set_next_pose(lift, Vec3::new(6.0, 0.5, 0.0), Quat::IDENTITY)
+        .unwrap();
+    let text = w.snapshot("kinematic", DT).to_ron().unwrap();
+    let mut restored = World::from_snapshot(Snapshot::parse(&text, "kinematic").unwrap()).unwrap();
+    for _ in 0..60 {
+        w.step(DT).unwrap();
+        restored.step(DT).unwrap();
+    }
+    assert_eq!(restored.state_hash(), w.state_hash());
+    assert_eq!(
+        restored.body(lift).unwrap().position,
+        Vec3::new(6.0, 0.5, 0.0)
+    );
+}
