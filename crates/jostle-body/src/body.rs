@@ -236,12 +236,14 @@ impl RigidBody {
     }
 
     /// The body's type.
+    #[inline]
     pub fn body_type(&self) -> BodyType {
         self.body_type
     }
 
     /// Whether the body is kinematic (moved by its velocity or its next pose, pushed by
     /// nothing).
+    #[inline]
     pub fn is_kinematic(&self) -> bool {
         matches!(
             self.body_type,
@@ -250,11 +252,13 @@ impl RigidBody {
     }
 
     /// Whether nothing can push the body: it is fixed or kinematic.
+    #[inline]
     pub fn is_immovable(&self) -> bool {
         self.body_type != BodyType::Dynamic
     }
 
     /// Whether a kinematic body moves in the next step (a velocity, or a next pose to reach).
+    #[inline]
     pub fn kinematic_moves(&self) -> bool {
         self.is_kinematic()
             && (self.next_pose.is_some()
@@ -346,16 +350,19 @@ impl RigidBody {
     }
 
     /// Whether the body is immovable.
+    #[inline]
     pub fn is_fixed(&self) -> bool {
         self.body_type == BodyType::Fixed
     }
 
     /// Whether the body is awake (fixed bodies report `false`: they are never simulated).
+    #[inline]
     pub fn is_awake(&self) -> bool {
         !self.is_fixed() && self.sleep.awake
     }
 
     /// Mass (kg); infinite for a fixed body.
+    #[inline]
     pub fn mass(&self) -> f32 {
         if self.is_immovable() {
             f32::INFINITY
@@ -371,16 +378,19 @@ impl RigidBody {
     }
 
     /// 1/mass (1/kg); zero for a fixed body.
+    #[inline]
     pub fn inv_mass(&self) -> f32 {
         self.inv_mass
     }
 
     /// Body-space inverse inertia tensor.
+    #[inline]
     pub fn inv_inertia_body(&self) -> Mat3 {
         self.inv_inertia_body
     }
 
     /// World-space inverse inertia R·I⁻¹·Rᵀ at the current orientation.
+    #[inline]
     pub fn inv_inertia_world(&self) -> Mat3 {
         self.inv_inertia_world
     }
@@ -399,12 +409,14 @@ impl RigidBody {
     }
 
     /// Whether the body's rotation is locked ([`RigidBody::lock_rotation`]).
+    #[inline]
     pub fn is_rotation_locked(&self) -> bool {
         self.body_type == BodyType::Dynamic && self.inv_inertia_body == Mat3::ZERO
     }
 
     /// Recomputes the world inverse inertia from the orientation; call after changing
     /// `orientation` directly.
+    #[inline]
     pub fn update_world_inertia(&mut self) {
         self.inv_inertia_world = world_inverse_inertia(self.orientation, self.inv_inertia_body);
     }
@@ -515,11 +527,13 @@ impl RigidBody {
     }
 
     /// Force accumulated for the next step (N).
+    #[inline]
     pub fn force(&self) -> Vec3 {
         self.force
     }
 
     /// Torque accumulated for the next step (N·m).
+    #[inline]
     pub fn torque(&self) -> Vec3 {
         self.torque
     }
@@ -549,6 +563,7 @@ impl RigidBody {
     }
 
     /// Clears the force and torque accumulators (done after every step).
+    #[inline]
     pub fn clear_forces(&mut self) {
         self.force = Vec3::ZERO;
         self.torque = Vec3::ZERO;

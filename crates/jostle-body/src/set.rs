@@ -18,11 +18,13 @@ pub struct BodyHandle {
 
 impl BodyHandle {
     /// The dense slot index (stable while the body lives); for inner loops and tables.
+    #[inline]
     pub fn index(self) -> u32 {
         self.index
     }
 
     /// The generation of the slot when the handle was issued.
+    #[inline]
     pub fn generation(self) -> u32 {
         self.generation
     }
@@ -78,36 +80,43 @@ impl BodySet {
     }
 
     /// The body behind `handle`, or `None` if it is stale or invalid.
+    #[inline]
     pub fn get(&self, handle: BodyHandle) -> Option<&RigidBody> {
         self.arena.get(handle.at())
     }
 
     /// The body behind `handle`, mutably, or `None` if it is stale or invalid.
+    #[inline]
     pub fn get_mut(&mut self, handle: BodyHandle) -> Option<&mut RigidBody> {
         self.arena.get_mut(handle.at())
     }
 
     /// Whether `handle` names a live body.
+    #[inline]
     pub fn contains(&self, handle: BodyHandle) -> bool {
         self.get(handle).is_some()
     }
 
     /// Number of live bodies.
+    #[inline]
     pub fn len(&self) -> usize {
         self.arena.len()
     }
 
     /// Whether there are no bodies.
+    #[inline]
     pub fn is_empty(&self) -> bool {
         self.arena.is_empty()
     }
 
     /// One past the largest slot index ever used: the size of a dense per-slot table.
+    #[inline]
     pub fn capacity_index(&self) -> usize {
         self.arena.capacity_index()
     }
 
     /// Live bodies with their handles, in slot order.
+    #[inline]
     pub fn iter(&self) -> impl Iterator<Item = (BodyHandle, &RigidBody)> {
         self.arena
             .iter()
@@ -115,6 +124,7 @@ impl BodySet {
     }
 
     /// Live bodies with their handles, mutably, in slot order.
+    #[inline]
     pub fn iter_mut(&mut self) -> impl Iterator<Item = (BodyHandle, &mut RigidBody)> {
         self.arena
             .iter_mut()
@@ -122,6 +132,7 @@ impl BodySet {
     }
 
     /// The live body in slot `index`, with its handle.
+    #[inline]
     pub fn by_index(&self, index: u32) -> Option<(BodyHandle, &RigidBody)> {
         self.arena
             .by_index(index)

@@ -90,11 +90,13 @@ impl Collider {
     }
 
     /// The shape, in the collider's frame.
+    #[inline]
     pub fn shape(&self) -> &SharedShape {
         &self.shape
     }
 
     /// The pose relative to the body's centre-of-mass frame.
+    #[inline]
     pub fn local_pose(&self) -> Pose {
         self.local_pose
     }
@@ -105,6 +107,7 @@ impl Collider {
     }
 
     /// What CCD needs of the shape (thickness and reach about the centre of mass).
+    #[inline]
     pub fn ccd_shape(&self) -> &CcdShape {
         &self.ccd
     }
@@ -136,6 +139,7 @@ impl Collider {
     }
 
     /// The collider's world pose on `body`: body pose (centre of mass, orientation) × local pose.
+    #[inline]
     pub fn world_pose(&self, body: &RigidBody) -> Pose {
         // Most colliders sit at their body's centre of mass: skip the composition.
         if self.local_pose == Pose::IDENTITY {
@@ -146,6 +150,7 @@ impl Collider {
     }
 
     /// Whether the shape is unbounded (a half-space): it has no finite bounding box.
+    #[inline]
     pub fn is_unbounded(&self) -> bool {
         self.shape.as_halfspace().is_some()
     }
@@ -171,16 +176,19 @@ impl ColliderHandle {
     }
 
     /// The dense slot index (stable while the collider lives).
+    #[inline]
     pub fn index(self) -> u32 {
         self.index
     }
 
     /// The generation of the slot when the handle was issued.
+    #[inline]
     pub fn generation(self) -> u32 {
         self.generation
     }
 
     /// Where the collider is in its set's [`Arena`].
+    #[inline]
     pub fn arena_index(self) -> ArenaIndex {
         ArenaIndex {
             index: self.index,
@@ -189,6 +197,7 @@ impl ColliderHandle {
     }
 
     /// The handle of the collider at `at` of a set's [`Arena`].
+    #[inline]
     pub fn from_arena_index(at: ArenaIndex) -> Self {
         Self::new(at.index, at.generation)
     }
@@ -249,17 +258,20 @@ impl ColliderSet {
     }
 
     /// The collider behind `handle`, or `None` if it is stale or invalid.
+    #[inline]
     pub fn get(&self, handle: ColliderHandle) -> Option<&Collider> {
         self.arena.get(handle.arena_index())
     }
 
     /// The collider behind `handle`, mutably. Changing its shape or local pose (through its
     /// setters) is picked up by the next broad- and narrow-phase update.
+    #[inline]
     pub fn get_mut(&mut self, handle: ColliderHandle) -> Option<&mut Collider> {
         self.arena.get_mut(handle.arena_index())
     }
 
     /// The live collider in slot `index`, with its handle.
+    #[inline]
     pub fn by_index(&self, index: u32) -> Option<(ColliderHandle, &Collider)> {
         self.arena
             .by_index(index)
@@ -267,21 +279,25 @@ impl ColliderSet {
     }
 
     /// Number of live colliders.
+    #[inline]
     pub fn len(&self) -> usize {
         self.arena.len()
     }
 
     /// Whether there are no colliders.
+    #[inline]
     pub fn is_empty(&self) -> bool {
         self.arena.is_empty()
     }
 
     /// One past the largest slot index ever used: the size of a dense per-slot table.
+    #[inline]
     pub fn capacity_index(&self) -> usize {
         self.arena.capacity_index()
     }
 
     /// Live colliders with their handles, in slot order.
+    #[inline]
     pub fn iter(&self) -> impl Iterator<Item = (ColliderHandle, &Collider)> {
         self.arena
             .iter()

@@ -8,6 +8,7 @@ use glam::{Quat, Vec3};
 ///
 /// First order: for |rotation| of 0.1 rad the result differs from the exact rotation by about
 /// 0.03%. Used both by integration (rotation = ω·dt) and by nonlinear projection.
+#[inline]
 pub fn integrate_orientation(q: Quat, rotation: Vec3) -> Quat {
     let spin = Quat::from_xyzw(rotation.x, rotation.y, rotation.z, 0.0) * q;
     let out = Quat::from_xyzw(
