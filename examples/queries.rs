@@ -111,3 +111,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     Ok(())
 }
+
+#[test]
+fn runs() {
+    main().expect("the example runs");
+}

@@ -68,3 +68,8 @@ fn main() {
     run(&mut SoftStepResolver::new(SoftStepSettings::default()));
     run(&mut MillingtonResolver::new(MillingtonSettings::default()));
 }
+
+#[test]
+fn runs() {
+    main();
+}

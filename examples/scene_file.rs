@@ -8,12 +8,18 @@ use jostle::scene::Scene;
 use jostle::{MillingtonSettings, ResolverChoice, SoftStepSettings, WorldSettings};
 use std::time::Instant;
 
+const DEFAULT_SCENE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/box_drop.ron");
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = std::env::args()
         .nth(1)
-        .unwrap_or_else(|| concat!(env!("CARGO_MANIFEST_DIR"), "/assets/box_drop.ron").into());
+        .unwrap_or_else(|| DEFAULT_SCENE.into());
+    run(&path)
+}
+
+fn run(path: &str) -> Result<(), Box<dyn std::error::Error>> {
     // A bad file is an error naming the file and line:column, or the body and the field.
-    let scene = Scene::load(&path)?;
+    let scene = Scene::load(path)?;
     println!("{} ({} steps of {} s)", scene.name, scene.steps, scene.dt);
 
     for resolver in [
@@ -42,4 +48,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     Ok(())
+}
+
+#[test]
+fn runs() {
+    run(DEFAULT_SCENE).expect("the example runs");
 }

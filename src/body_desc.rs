@@ -1,7 +1,7 @@
 //! `BodyDesc`: everything needed to add a body with its shape to a world, with documented
 //! defaults, and the errors that name the offending field.
 
-use jostle_body::CcdMode;
+use jostle_body::{BodyType, CcdMode, KinematicPath};
 use jostle_collide::{Material, ShapeDesc, ShapeError};
 use jostle_math::{Quat, Vec3};
 use thiserror::Error;
@@ -104,6 +104,74 @@ pub struct BodyDesc {
     /// resolvers skip its angular terms). Default false. `angular_velocity` must then be zero.
     /// Ignored for fixed bodies.
     pub lock_rotation: bool,
+    /// Makes the body kinematic: moved by its velocity, to the poses it is sent to, or along
+    /// a path; it pushes dynamic bodies and nothing pushes it. `None` (the default): dynamic,
+    /// or fixed with `fixed`.
+    pub kinematic: Option<Kinematic>,
+}
+
+/// How a kinematic body moves ([`BodyDesc::kinematic`], scene field `kinematic`). Its mass
+/// properties are those of a dynamic body of its shape and `mass`, kept for when it is made
+/// dynamic ([`crate::World::set_body_type`]).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum Kinematic {
+    /// Moved by its velocity (`linear_velocity`, `angular_velocity`) until told otherwise
+    /// ([`crate::World::set_velocity`]).
+    Velocity,
+    /// Moved to the poses it is sent to ([`crate::World::set_next_pose`]); at rest otherwise.
+    Position,
+    /// Back and forth along `offset` (m) from where it starts, smoothly, there and back once
+    /// per `period` (s, > 0) ([`KinematicPath::Line`]).
+    Line {
+        /// From the start to the far end (m).
+        offset: Vec3,
+        /// Time for the way there and back (s).
+        period: f32,
+    },
+    /// A rigid turn about the axis through `center` along `axis`, once per `period` (s,
+    /// non-zero; negative turns the other way) ([`KinematicPath::Turn`]); with the centre at
+    /// the body it spins in place.
+    Turn {
+        /// A point on the axis (m).
+        center: Vec3,
+        /// The axis's direction (right-handed turns for a positive period).
+        axis: Vec3,
+        /// Time for one turn (s).
+        period: f32,
+    },
+}
+
+impl Kinematic {
+    /// The body type and, for a scripted motion, the path starting from the pose given.
+    pub fn start(self, position: Vec3, rotation: Quat) -> (BodyType, Option<KinematicPath>) {
+        match self {
+            Self::Velocity => (BodyType::KinematicVelocity, None),
+            Self::Position => (BodyType::KinematicPosition, None),
+            Self::Line { offset, period } => (
+                BodyType::KinematicPosition,
+                Some(KinematicPath::Line {
+                    start: position,
+                    rotation,
+                    offset,
+                    period,
+                }),
+            ),
+            Self::Turn {
+                center,
+                axis,
+                period,
+            } => (
+                BodyType::KinematicPosition,
+                Some(KinematicPath::Turn {
+                    start: position,
+                    rotation,
+                    center,
+                    axis,
+                    period,
+                }),
+            ),
+        }
+    }
 }
 
 impl BodyDesc {
@@ -124,6 +192,15 @@ impl BodyDesc {
             fixed: false,
             ccd: CcdMode::Auto,
             lock_rotation: false,
+            kinematic: None,
+        }
+    }
+
+    /// A kinematic body moving as `kinematic` says, with the defaults above.
+    pub fn kinematic(name: impl Into<String>, shape: ShapeDesc, kinematic: Kinematic) -> Self {
+        Self {
+            kinematic: Some(kinematic),
+            ..Self::dynamic(name, shape)
         }
     }
 
@@ -277,6 +354,19 @@ impl BodyDesc {
                 "fixed",
                 "a half-space has no finite mass: it must be `fixed: true`".into(),
             ));
+        }
+        if let Some(kinematic) = self.kinematic {
+            if self.fixed {
+                return Err(err(
+                    "kinematic",
+                    "a body is `fixed` or `kinematic`, not both".into(),
+                ));
+            }
+            let rotation = unit_rotation(self.rotation).unwrap_or(Quat::IDENTITY);
+            if let (_, Some(path)) = kinematic.start(self.position, rotation) {
+                path.check()
+                    .map_err(|(field, message)| err(&format!("kinematic.{field}"), message))?;
+            }
         }
         Ok(())
     }

@@ -37,10 +37,10 @@ pub mod view;
 pub mod world;
 
 pub use body_desc::{
-    BodyDesc, BodyError, MAX_ANGULAR_SPEED, MAX_DENSITY, MAX_DT, MAX_GRAVITY, MAX_MASS,
+    BodyDesc, BodyError, Kinematic, MAX_ANGULAR_SPEED, MAX_DENSITY, MAX_DT, MAX_GRAVITY, MAX_MASS,
     MAX_POSITION, MAX_SPEED, MassSpec,
 };
-pub use jostle_body::{BodyHandle, BodyType, CcdMode, RigidBody};
+pub use jostle_body::{BodyHandle, BodyType, CcdMode, KinematicPath, RigidBody};
 pub use jostle_collide::{
     BodyContact, CollideSettings, CollisionEvent, Combine, DisplayMesh, Material, PointHit, Pose,
     Queries, QueryFilter, RayHit, ShapeDesc, ShapeHit, SharedShape,

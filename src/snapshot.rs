@@ -366,6 +366,7 @@ mod file {
             }
             world.time = snapshot.time;
             world.steps = snapshot.steps;
+            world.paths = world.bodies.iter().any(|(_, b)| b.path().is_some());
             Ok(world)
         }
     }

@@ -11,7 +11,7 @@ use crate::body_desc::{
 use crate::profile::StepProfile;
 use crate::settings::{ResolverChoice, WorldSettings};
 use crate::stages::{self, Scratch};
-use jostle_body::{BodyHandle, BodySet, BodyType, CcdMode, RigidBody};
+use jostle_body::{BodyHandle, BodySet, BodyType, CcdMode, KinematicPath, RigidBody};
 use jostle_collide::{
     BodyContact, BroadPhase, Collider, ColliderHandle, ColliderSet, CollisionEvent, Material,
     NarrowPhase, Queries, QueryFilter, RayHit,
@@ -98,6 +98,9 @@ pub struct World {
     /// the broad phase's tree serves queries while `query_stamp` equals it.
     stamp: u64,
     query_stamp: u64,
+    /// Whether any body was given a path ([`World::set_path`]): then each step sends the
+    /// bodies that have one along it.
+    pub(crate) paths: bool,
 }
 
 impl World {
@@ -118,6 +121,7 @@ impl World {
             scratch: Scratch::default(),
             stamp: 1,
             query_stamp: 0,
+            paths: false,
         }
     }
 
@@ -182,6 +186,17 @@ impl World {
         body.sleep.motion = 2.0 * self.settings.sleep.threshold;
         body.ccd = desc.ccd;
         body.name = desc.name;
+        if let Some(kinematic) = desc.kinematic {
+            let (body_type, path) = kinematic.start(body.position, body.orientation);
+            body.set_body_type(body_type)
+                .map_err(|e| BodyError::Field {
+                    body: body.name.clone(),
+                    field: "kinematic".into(),
+                    message: e.to_string(),
+                })?;
+            self.paths |= path.is_some();
+            body.set_path(path);
+        }
         let handle = self.bodies.insert(body);
         self.colliders.insert(
             Collider::new(shape, handle)
@@ -666,6 +681,62 @@ impl World {
         Ok(())
     }
 
+    /// Gives a body a scripted motion ([`KinematicPath`]: back and forth along a line, or a
+    /// turn about an axis) that every step follows from then on, the path's time being the
+    /// world's ([`World::time`]); the body becomes position-based kinematic if it was not.
+    /// `None` takes the path away (the body stays kinematic, at rest). The path's numbers are
+    /// checked ([`StepError::Invalid`] names the field, nothing changes).
+    ///
+    /// ```
+    /// use jostle::{BodyDesc, KinematicPath, Quat, ShapeDesc, Vec3, World, WorldSettings};
+    ///
+    /// let mut world = World::new(WorldSettings::default());
+    /// let arm = world
+    ///     .add_body(BodyDesc::dynamic("arm", ShapeDesc::Cuboid { half_extents: Vec3::new(1.0, 0.1, 0.1) })
+    ///         .at(Vec3::new(1.0, 0.5, 0.0)))
+    ///     .unwrap();
+    /// // Round the vertical axis through the origin, once every 4 s.
+    /// let path = KinematicPath::Turn {
+    ///     start: Vec3::new(1.0, 0.5, 0.0),
+    ///     rotation: Quat::IDENTITY,
+    ///     center: Vec3::ZERO,
+    ///     axis: Vec3::Y,
+    ///     period: 4.0,
+    /// };
+    /// world.set_path(arm, Some(path)).unwrap();
+    /// for _ in 0..60 {
+    ///     world.step(1.0 / 60.0).unwrap();
+    /// }
+    /// // A quarter turn in one second: +x went to −z.
+    /// let p = world.body(arm).unwrap().position;
+    /// assert!((p - Vec3::new(0.0, 0.5, -1.0)).length() < 1e-3, "{p}");
+    /// ```
+    pub fn set_path(
+        &mut self,
+        handle: BodyHandle,
+        path: Option<KinematicPath>,
+    ) -> Result<(), StepError> {
+        if let Some(path) = &path {
+            path.check()
+                .map_err(|(field, message)| invalid((&format!("path.{field}"), message)))?;
+        }
+        let body_type = self
+            .bodies
+            .get(handle)
+            .ok_or(StepError::InvalidHandle(handle))?
+            .body_type();
+        if path.is_some() && body_type != BodyType::KinematicPosition {
+            self.set_body_type(handle, BodyType::KinematicPosition)?;
+        }
+        let body = self
+            .bodies
+            .get_mut(handle)
+            .ok_or(StepError::InvalidHandle(handle))?;
+        body.set_path(path);
+        self.paths |= path.is_some();
+        Ok(())
+    }
+
     /// Sends a position-based kinematic body ([`BodyType::KinematicPosition`]) to a pose,
     /// which it reaches at the end of the next step, moving at the velocity that takes it
     /// there (so that what it pushes or carries moves with it). Without a new pose it stays
@@ -947,6 +1018,12 @@ impl World {
         let start = Instant::now();
         let mut p = StepProfile::default();
         let mut report = StepReport::default();
+        if self.paths {
+            let end = self.time + f64::from(dt);
+            for (_, body) in self.bodies.iter_mut() {
+                body.follow_path(end);
+            }
+        }
 
         self.detect(&mut p);
 

@@ -321,3 +321,162 @@ fn kinematic_bodies_round_trip_through_snapshots() {
         Vec3::new(6.0, 0.5, 0.0)
     );
 }
+
+/// `assets/paddle.ron`: a paddle turning about a vertical axis (scene field `kinematic:
+/// Turn(...)`) is where its path says at every step, reaches the tower after a quarter turn
+/// and knocks it down; a pusher sliding back and forth (`Line(...)`) pushes a crate 3 m along
+/// and leaves it there.
+#[test]
+fn the_paddle_scene_follows_its_paths_and_knocks_the_tower_down() {
+    let scene =
+        jostle::scene::Scene::load(format!("{}/assets/paddle.ron", env!("CARGO_MANIFEST_DIR")))
+            .unwrap();
+    let mut w = scene.build().unwrap();
+    let find = |w: &World, name: &str| w.find_body(name).unwrap();
+    let (paddle, pusher, crate_) = (find(&w, "paddle"), find(&w, "pusher"), find(&w, "crate"));
+    let tower: Vec<_> = w
+        .bodies()
+        .filter(|(_, name, _)| name.starts_with("tower"))
+        .map(|(h, _, b)| (h, b.position))
+        .collect();
+    assert_eq!(tower.len(), 36);
+    let moved = |w: &World| {
+        tower
+            .iter()
+            .filter(|(h, start)| (w.body(*h).unwrap().position - *start).length() > 0.5)
+            .count()
+    };
+    for step in 1..=360 {
+        w.step(scene.dt).unwrap();
+        let t = step as f32 * scene.dt;
+        let angle = std::f32::consts::TAU * t / 8.0;
+        let expected = Vec3::new(3.0 * angle.sin(), 0.6, 3.0 * angle.cos());
+        let p = w.body(paddle).unwrap();
+        assert!(
+            (p.position - expected).length() < 1e-3,
+            "step {step}: paddle at {} instead of {expected}",
+            p.position
+        );
+        assert!(p.is_kinematic());
+        if step == 60 {
+            assert_eq!(moved(&w), 0, "the paddle has not reached the tower at 1 s");
+        }
+        if step == 120 {
+            // The pusher's far end: 3 m on; the crate ahead of its face.
+            let x = w.body(pusher).unwrap().position.x;
+            assert!((x + 3.0).abs() < 1e-3, "pusher at x = {x}");
+            let c = w.body(crate_).unwrap().position.x;
+            assert!((c + 2.5).abs() < 0.02, "crate at x = {c}");
+        }
+    }
+    assert!(
+        moved(&w) >= 30,
+        "{} of 36 tower boxes knocked over",
+        moved(&w)
+    );
+}
+
+/// `World::set_path` checks the path, makes the body position-based kinematic, and the path
+/// survives a snapshot: the restored world goes on exactly like the original.
+#[test]
+fn paths_are_checked_made_kinematic_and_kept_in_snapshots() {
+    use jostle::{KinematicPath, StepError};
+    let mut w = world(ResolverChoice::default());
+    let arm = w
+        .add_body(boxed(
+            "arm",
+            Vec3::new(1.0, 0.1, 0.1),
+            Vec3::new(2.0, 0.5, 0.0),
+        ))
+        .unwrap();
+    w.add_body(boxed("box", Vec3::splat(0.25), Vec3::new(0.0, 0.25, 2.0)))
+        .unwrap();
+    let turn = KinematicPath::Turn {
+        start: Vec3::new(2.0, 0.5, 0.0),
+        rotation: Quat::IDENTITY,
+        center: Vec3::new(0.0, 0.5, 0.0),
+        axis: Vec3::ZERO,
+        period: 4.0,
+    };
+    let field = |e: StepError| match e {
+        StepError::Invalid { field, .. } => field,
+        other => panic!("expected an invalid field, got {other:?}"),
+    };
+    assert_eq!(field(w.set_path(arm, Some(turn)).unwrap_err()), "path.axis");
+    let line = KinematicPath::Line {
+        start: Vec3::new(2.0, 0.5, 0.0),
+        rotation: Quat::IDENTITY,
+        offset: Vec3::X,
+        period: -1.0,
+    };
+    assert_eq!(
+        field(w.set_path(arm, Some(line)).unwrap_err()),
+        "path.period"
+    );
+    assert_eq!(w.body(arm).unwrap().body_type(), BodyType::Dynamic);
+    let turn = KinematicPath::Turn {
+        start: Vec3::new(2.0, 0.5, 0.0),
+        rotation: Quat::IDENTITY,
+        center: Vec3::new(0.0, 0.5, 0.0),
+        axis: Vec3::Y,
+        period: 4.0,
+    };
+    w.set_path(arm, Some(turn)).unwrap();
+    assert_eq!(
+        w.body(arm).unwrap().body_type(),
+        BodyType::KinematicPosition
+    );
+    steps(&mut w, 30);
+    let text = w.snapshot("path", DT).to_ron().unwrap();
+    let mut restored = World::from_snapshot(Snapshot::parse(&text, "path").unwrap()).unwrap();
+    for _ in 0..90 {
+        w.step(DT).unwrap();
+        restored.step(DT).unwrap();
+    }
+    assert_eq!(restored.state_hash(), w.state_hash());
+    // Two seconds: half a turn, from +x to −x.
+    let p = restored.body(arm).unwrap().position;
+    assert!((p - Vec3::new(-2.0, 0.5, 0.0)).length() < 1e-3, "{p}");
+    // Taken away, the arm stops where it is.
+    w.set_path(arm, None).unwrap();
+    steps(&mut w, 10);
+    assert!((w.body(arm).unwrap().position - p).length() < 1e-6);
+}
+
+/// A scene's `kinematic` field is checked like the others: the error names the body and the
+/// field.
+#[test]
+fn scene_kinematic_fields_are_checked() {
+    let bad = [
+        (
+            "kinematic: Line(offset: (1.0, 0.0, 0.0), period: 0.0)",
+            "kinematic.period",
+        ),
+        (
+            "kinematic: Turn(center: (0.0, 0.0, 0.0), axis: (0.0, 0.0, 0.0), period: 2.0)",
+            "kinematic.axis",
+        ),
+        ("fixed: true, kinematic: Velocity", "kinematic"),
+    ];
+    for (field, named) in bad {
+        let text = format!("Scene(bodies: [Body(name: \"k\", shape: Ball(radius: 0.5), {field})])");
+        let e = jostle::scene::Scene::parse(&text, "k.ron")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(named) && e.contains("\"k\""), "{field}: {e}");
+    }
+    let good = "Scene(bodies: [Body(name: \"k\", shape: Ball(radius: 0.5), \
+                linear_velocity: (1.0, 0.0, 0.0), kinematic: Velocity)])";
+    let scene = jostle::scene::Scene::parse(good, "k.ron").unwrap();
+    let mut w = scene.build().unwrap();
+    for _ in 0..60 {
+        w.step(scene.dt).unwrap();
+    }
+    let b = w.body(w.find_body("k").unwrap()).unwrap();
+    assert_eq!(b.body_type(), BodyType::KinematicVelocity);
+    assert!(
+        (b.position.x - 60.0 * scene.dt).abs() < 1e-4,
+        "{}",
+        b.position
+    );
+}

@@ -231,6 +231,12 @@ pub struct BodySpec {
     /// Lock the rotation (the body translates but never turns). Default false.
     #[serde(default)]
     pub lock_rotation: bool,
+    /// Makes the body kinematic (pushes dynamic bodies, pushed by nothing): `Velocity` (moved
+    /// by `linear_velocity` and `angular_velocity`), `Position` (moved by the program),
+    /// `Line(offset: (x, y, z), period: s)` (back and forth) or `Turn(center: (x, y, z),
+    /// axis: (x, y, z), period: s)` (round an axis). Default: none.
+    #[serde(default)]
+    pub kinematic: Option<crate::Kinematic>,
 }
 
 fn identity() -> Quat {
@@ -273,6 +279,7 @@ impl BodySpec {
             fixed: self.fixed,
             ccd: self.ccd,
             lock_rotation: self.lock_rotation,
+            kinematic: self.kinematic,
         };
         desc.validate()?;
         Ok(desc)

@@ -1,5 +1,6 @@
 //! `RigidBody`: one body's mass properties, state, forces and sleep state.
 
+use crate::KinematicPath;
 use jostle_math::{Mat3, Quat, Vec3, world_inverse_inertia};
 use thiserror::Error;
 
@@ -122,6 +123,12 @@ pub struct RigidBody {
     /// ([`RigidBody::set_next_pose`]).
     #[cfg_attr(feature = "serde", serde(default))]
     next_pose: Option<(Vec3, Quat)>,
+    /// The scripted motion of a position-based kinematic body ([`RigidBody::set_path`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Option::is_none")
+    )]
+    path: Option<KinematicPath>,
     /// Scale of the world's gravity on this body (dimensionless; 1 by default, 0 floats, −1
     /// falls up).
     #[cfg_attr(feature = "serde", serde(default = "one"))]
@@ -215,6 +222,9 @@ impl RigidBody {
                 self.angular_velocity = Vec3::ZERO;
             }
             self.next_pose = None;
+            if body_type != BodyType::KinematicPosition {
+                self.path = None;
+            }
             self.last_acceleration = Vec3::ZERO;
             self.clear_forces();
             self.update_world_inertia();
@@ -230,6 +240,7 @@ impl RigidBody {
         }
         dynamic.locked_while_fixed = false;
         dynamic.next_pose = None;
+        dynamic.path = None;
         dynamic.sleep.awake = true;
         *self = dynamic;
         Ok(())
@@ -272,6 +283,31 @@ impl RigidBody {
         if self.body_type == BodyType::KinematicPosition {
             self.next_pose = Some((position, orientation.normalize()));
         }
+    }
+
+    /// The scripted motion of a position-based kinematic body, if it has one.
+    pub fn path(&self) -> Option<&KinematicPath> {
+        self.path.as_ref()
+    }
+
+    /// Gives a position-based kinematic body a scripted motion (or takes it away with
+    /// `None`): [`RigidBody::follow_path`] then sends it along. Does nothing to other bodies;
+    /// changing the body's type to any other takes the path away.
+    pub fn set_path(&mut self, path: Option<KinematicPath>) {
+        if self.body_type == BodyType::KinematicPosition {
+            self.path = path;
+        }
+    }
+
+    /// Sends a body with a path to the path's pose at time `t` (s; the end of the coming
+    /// step), as [`RigidBody::set_next_pose`] would. Returns whether it had a path.
+    pub fn follow_path(&mut self, t: f64) -> bool {
+        let Some(path) = self.path else {
+            return false;
+        };
+        let (position, orientation) = path.pose_at(t);
+        self.set_next_pose(position, orientation);
+        true
     }
 
     /// The next pose of a position-based kinematic body, taken for the step: sets the
@@ -324,6 +360,7 @@ impl RigidBody {
             body_type: BodyType::Fixed,
             locked_while_fixed: false,
             next_pose: None,
+            path: None,
             gravity_scale: 1.0,
         }
     }
@@ -439,6 +476,16 @@ impl RigidBody {
         vector("angular_velocity", self.angular_velocity)?;
         vector("last_acceleration", self.last_acceleration)?;
         vector("force", self.force)?;
+        if let Some(path) = &self.path {
+            path.check()
+                .map_err(|(field, message)| ("path", format!("{field} {message}")))?;
+            if self.body_type != BodyType::KinematicPosition {
+                return Err((
+                    "path",
+                    "only a position-based kinematic body follows a path".into(),
+                ));
+            }
+        }
         vector("torque", self.torque)?;
         let length = self.orientation.length();
         if !(self.orientation.is_finite() && (length - 1.0).abs() < 1e-3) {

@@ -10,9 +10,11 @@
 pub mod arena;
 pub mod body;
 pub mod integrate;
+pub mod path;
 pub mod set;
 
 pub use arena::{Arena, ArenaIndex};
 pub use body::{BodyType, CcdMode, MassError, RigidBody, SleepState};
 pub use integrate::{apply_forces, integrate_body};
+pub use path::KinematicPath;
 pub use set::{BodyHandle, BodySet};
