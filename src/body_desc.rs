@@ -2,7 +2,7 @@
 //! defaults, and the errors that name the offending field.
 
 use jostle_body::{BodyType, CcdMode, KinematicPath};
-use jostle_collide::{Material, ShapeDesc, ShapeError};
+use jostle_collide::{CollisionGroups, Material, ShapeDesc, ShapeError};
 use jostle_math::{Quat, Vec3};
 use thiserror::Error;
 
@@ -108,6 +108,11 @@ pub struct BodyDesc {
     /// a path; it pushes dynamic bodies and nothing pushes it. `None` (the default): dynamic,
     /// or fixed with `fixed`.
     pub kinematic: Option<Kinematic>,
+    /// A sensor: no contacts, only the colliders that enter and leave it
+    /// ([`crate::World::sensor_events`]). Default false.
+    pub sensor: bool,
+    /// Which colliders it meets ([`CollisionGroups`]). Default: all.
+    pub groups: CollisionGroups,
 }
 
 /// How a kinematic body moves ([`BodyDesc::kinematic`], scene field `kinematic`). Its mass
@@ -193,6 +198,8 @@ impl BodyDesc {
             ccd: CcdMode::Auto,
             lock_rotation: false,
             kinematic: None,
+            sensor: false,
+            groups: CollisionGroups::ALL,
         }
     }
 
@@ -234,6 +241,18 @@ impl BodyDesc {
     /// Locks the rotation (see [`BodyDesc::lock_rotation`]).
     pub fn with_locked_rotation(mut self) -> Self {
         self.lock_rotation = true;
+        self
+    }
+
+    /// Makes the body's collider a sensor ([`BodyDesc::sensor`]).
+    pub fn as_sensor(mut self) -> Self {
+        self.sensor = true;
+        self
+    }
+
+    /// Sets the collision groups ([`BodyDesc::groups`]).
+    pub fn with_groups(mut self, groups: CollisionGroups) -> Self {
+        self.groups = groups;
         self
     }
 

@@ -22,6 +22,12 @@ pub struct ColliderRecord {
     pub material: Material,
     /// The body it is attached to.
     pub body: BodyHandle,
+    /// Collision groups (default: all).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub groups: jostle_collide::CollisionGroups,
+    /// Whether it is a sensor (default: no).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub sensor: bool,
 }
 
 #[cfg(feature = "scene")]
@@ -249,6 +255,8 @@ mod file {
                             local_pose: c.local_pose(),
                             material: c.material,
                             body: c.body,
+                            groups: c.groups,
+                            sensor: c.sensor,
                         })
                     })
                     .unwrap_or_else(|never| match never {}),
@@ -341,7 +349,9 @@ mod file {
                     .map_err(|e| invalid(format!("collider {}: {e}", at.index)))?;
                 Ok(collider
                     .with_local_pose(record.local_pose)
-                    .with_material(record.material))
+                    .with_material(record.material)
+                    .with_groups(record.groups)
+                    .with_sensor(record.sensor))
             })?;
             world.colliders = ColliderSet::from_arena(colliders);
             let inv_mass = |c: &Collider| world.bodies.get(c.body).map_or(0.0, |b| b.inv_mass());

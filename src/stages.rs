@@ -273,15 +273,17 @@ pub(crate) fn ccd(
     scratch.ccd_fast.clear();
     scratch.ccd_fast.resize(colliders.capacity_index(), false);
     for (handle, collider) in colliders.iter() {
-        if sweep_motion(
-            bodies,
-            collider,
-            collider.ccd_shape(),
-            settings,
-            dt,
-            scratch,
-        )
-        .is_some()
+        // A sensor stops nothing and is stopped by nothing.
+        if !collider.sensor
+            && sweep_motion(
+                bodies,
+                collider,
+                collider.ccd_shape(),
+                settings,
+                dt,
+                scratch,
+            )
+            .is_some()
         {
             scratch.ccd_fast[handle.index() as usize] = true;
         }

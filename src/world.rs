@@ -13,8 +13,8 @@ use crate::settings::{ResolverChoice, WorldSettings};
 use crate::stages::{self, Scratch};
 use jostle_body::{BodyHandle, BodySet, BodyType, CcdMode, KinematicPath, RigidBody};
 use jostle_collide::{
-    BodyContact, BroadPhase, Collider, ColliderHandle, ColliderSet, CollisionEvent, Material,
-    NarrowPhase, Queries, QueryFilter, RayHit,
+    BodyContact, BroadPhase, Collider, ColliderHandle, ColliderSet, CollisionEvent,
+    CollisionGroups, Material, NarrowPhase, Queries, QueryFilter, RayHit, SensorEvent,
 };
 use jostle_math::{Quat, Vec3};
 use jostle_resolve::{Resolver, StepContext};
@@ -202,7 +202,9 @@ impl World {
             Collider::new(shape, handle)
                 .with_desc(desc.shape)
                 .with_local_pose(local_pose)
-                .with_material(desc.material),
+                .with_material(desc.material)
+                .with_groups(desc.groups)
+                .with_sensor(desc.sensor),
         );
         Ok(handle)
     }
@@ -493,6 +495,58 @@ impl World {
         let body = collider.body;
         self.islands
             .wake(&mut self.bodies, body, &self.settings.sleep);
+        Ok(())
+    }
+
+    /// Makes a collider a sensor, or a solid collider again ([`Collider::sensor`]): a sensor
+    /// makes no contacts and reports what enters and leaves it ([`World::sensor_events`]).
+    /// What its body touched wakes.
+    ///
+    /// ```
+    /// use jostle::{BodyDesc, SensorEvent, ShapeDesc, Vec3, World, WorldSettings};
+    ///
+    /// let mut world = World::new(WorldSettings::default());
+    /// let gate = world
+    ///     .add_body(BodyDesc::fixed("gate", ShapeDesc::Cuboid { half_extents: Vec3::new(2.0, 0.1, 2.0) }))
+    ///     .unwrap();
+    /// world.set_sensor(world.colliders_of(gate)[0], true).unwrap();
+    /// world
+    ///     .add_body(BodyDesc::dynamic("ball", ShapeDesc::Ball { radius: 0.2 }).at(Vec3::new(0.0, 1.0, 0.0)))
+    ///     .unwrap();
+    /// let mut entered = false;
+    /// for _ in 0..60 {
+    ///     world.step(1.0 / 60.0).unwrap();
+    ///     entered |= world.sensor_events().iter().any(|e| matches!(e, SensorEvent::Entered { .. }));
+    /// }
+    /// // The ball fell through the gate and was seen.
+    /// assert!(entered);
+    /// ```
+    pub fn set_sensor(&mut self, handle: ColliderHandle, sensor: bool) -> Result<(), StepError> {
+        let collider = self
+            .colliders
+            .get_mut(handle)
+            .ok_or(StepError::InvalidCollider(handle))?;
+        collider.sensor = sensor;
+        let body = collider.body;
+        self.wake_around(body);
+        self.stamp += 1;
+        Ok(())
+    }
+
+    /// Sets a collider's collision groups ([`CollisionGroups`]): which colliders it makes
+    /// contacts with (or, for a sensor, reports). What its body touched wakes.
+    pub fn set_collision_groups(
+        &mut self,
+        handle: ColliderHandle,
+        groups: CollisionGroups,
+    ) -> Result<(), StepError> {
+        let collider = self
+            .colliders
+            .get_mut(handle)
+            .ok_or(StepError::InvalidCollider(handle))?;
+        collider.groups = groups;
+        let body = collider.body;
+        self.wake_around(body);
         Ok(())
     }
 
@@ -889,6 +943,16 @@ impl World {
         self.narrow.events()
     }
 
+    /// Colliders that started or stopped overlapping a sensor in the last step.
+    pub fn sensor_events(&self) -> &[SensorEvent] {
+        self.narrow.sensor_events()
+    }
+
+    /// The colliders overlapping each sensor now: (sensor, other), sorted.
+    pub fn sensor_overlaps(&self) -> &[(ColliderHandle, ColliderHandle)] {
+        self.narrow.sensor_overlaps()
+    }
+
     /// Largest penetration (m) among the last step's contacts, 0 if none overlap.
     pub fn max_penetration(&self) -> f32 {
         self.narrow
@@ -1036,7 +1100,11 @@ impl World {
         );
         p.islands += t.elapsed();
         if woke {
+            // Again with the bodies that woke; the first update's events are kept (the
+            // second sees its touching pairs as old ones).
+            let events = self.narrow.take_events();
             self.detect(&mut p);
+            self.narrow.restore_events(events);
         }
 
         let t = Instant::now();

@@ -237,6 +237,13 @@ pub struct BodySpec {
     /// axis: (x, y, z), period: s)` (round an axis). Default: none.
     #[serde(default)]
     pub kinematic: Option<crate::Kinematic>,
+    /// A sensor: makes no contacts, reports what enters and leaves it. Default false.
+    #[serde(default)]
+    pub sensor: bool,
+    /// Collision groups, `(memberships: bits, filter: bits)`: the body's collider meets
+    /// another when each one's memberships share a bit with the other's filter. Default: all.
+    #[serde(default)]
+    pub groups: jostle_collide::CollisionGroups,
 }
 
 fn identity() -> Quat {
@@ -280,6 +287,8 @@ impl BodySpec {
             ccd: self.ccd,
             lock_rotation: self.lock_rotation,
             kinematic: self.kinematic,
+            sensor: self.sensor,
+            groups: self.groups,
         };
         desc.validate()?;
         Ok(desc)

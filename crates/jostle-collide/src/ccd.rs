@@ -225,7 +225,7 @@ pub fn sweep(
         let Some(target_body) = bodies.get(target.body) else {
             continue;
         };
-        if target.body == collider.body {
+        if target.body == collider.body || !collider.touches(target) {
             continue;
         }
         let to = target.world_pose(target_body);

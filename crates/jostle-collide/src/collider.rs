@@ -8,6 +8,7 @@
 
 use crate::ccd::CcdShape;
 use crate::display::DisplayMesh;
+use crate::groups::CollisionGroups;
 use crate::material::Material;
 use crate::shape::{ShapeDesc, ShapeError};
 use jostle_body::{Arena, ArenaIndex, BodyHandle, RigidBody};
@@ -28,6 +29,12 @@ pub struct Collider {
     pub material: Material,
     /// The body the collider moves with.
     pub body: BodyHandle,
+    /// Which colliders it meets ([`CollisionGroups`]; default: all).
+    pub groups: CollisionGroups,
+    /// A sensor makes no contacts: it reports the colliders that start and stop overlapping
+    /// it ([`crate::SensorEvent`]) and lets them pass. CCD and, unless they ask for them,
+    /// queries ignore it.
+    pub sensor: bool,
     /// What CCD needs of the shape, computed whenever the shape or local pose is set.
     pub(crate) ccd: CcdShape,
     /// The description the shape was built from ([`Collider::from_desc`]), for snapshots.
@@ -43,6 +50,8 @@ impl std::fmt::Debug for Collider {
             .field("local_pose", &self.local_pose)
             .field("material", &self.material)
             .field("body", &self.body)
+            .field("groups", &self.groups)
+            .field("sensor", &self.sensor)
             .finish()
     }
 }
@@ -55,6 +64,8 @@ impl Collider {
             local_pose: Pose::IDENTITY,
             material: Material::default(),
             body,
+            groups: CollisionGroups::ALL,
+            sensor: false,
             ccd: CcdShape {
                 thickness: 0.0,
                 extent: 0.0,
@@ -81,6 +92,25 @@ impl Collider {
     pub fn with_local_pose(mut self, local_pose: Pose) -> Self {
         self.set_local_pose(local_pose);
         self
+    }
+
+    /// Sets the collision groups.
+    pub fn with_groups(mut self, groups: CollisionGroups) -> Self {
+        self.groups = groups;
+        self
+    }
+
+    /// Makes the collider a sensor (or not).
+    pub fn with_sensor(mut self, sensor: bool) -> Self {
+        self.sensor = sensor;
+        self
+    }
+
+    /// Whether the collider can make contacts with `other`: neither is a sensor and their
+    /// groups meet.
+    #[inline]
+    pub fn touches(&self, other: &Collider) -> bool {
+        !self.sensor && !other.sensor && self.groups.meets(&other.groups)
     }
 
     /// Sets the material (builder style).

@@ -78,6 +78,28 @@ pub enum CollisionEvent {
     Stopped(BodyHandle, BodyHandle),
 }
 
+/// A collider started or stopped overlapping a sensor during an update
+/// ([`crate::Collider::sensor`]). When both are sensors, `sensor` is the lower handle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum SensorEvent {
+    /// `other` overlaps `sensor` now and did not at the previous update.
+    Entered {
+        /// The sensor.
+        sensor: ColliderHandle,
+        /// The collider that came in.
+        other: ColliderHandle,
+    },
+    /// `other` overlapped `sensor` at the previous update and no longer does (or one of
+    /// them was removed, or stopped being a sensor or meeting the other's groups).
+    Exited {
+        /// The sensor.
+        sensor: ColliderHandle,
+        /// The collider that left.
+        other: ColliderHandle,
+    },
+}
+
 /// Counts of one narrow-phase update.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct NarrowStats {
@@ -196,6 +218,14 @@ pub struct NarrowPhase {
     slots: Vec<PointSlot>,
     touching: Vec<(BodyHandle, BodyHandle)>,
     events: Vec<CollisionEvent>,
+    /// Collider pairs (sensor first) overlapping at the last update, sorted.
+    #[cfg_attr(feature = "serde", serde(default))]
+    overlaps: Vec<(ColliderHandle, ColliderHandle)>,
+    #[cfg_attr(feature = "serde", serde(default))]
+    sensor_events: Vec<SensorEvent>,
+    /// Scratch for the overlapping pairs of an update.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    overlaps_scratch: Vec<(ColliderHandle, ColliderHandle)>,
 }
 
 impl std::fmt::Debug for NarrowPhase {
@@ -347,6 +377,37 @@ impl NarrowPhase {
         &self.events
     }
 
+    /// Takes the last update's events (contact and sensor), leaving none: for a caller that
+    /// updates twice in one step and gives them back with [`NarrowPhase::restore_events`].
+    pub fn take_events(&mut self) -> (Vec<CollisionEvent>, Vec<SensorEvent>) {
+        (
+            std::mem::take(&mut self.events),
+            std::mem::take(&mut self.sensor_events),
+        )
+    }
+
+    /// Puts events taken with [`NarrowPhase::take_events`] before the last update's, so that a
+    /// second update in one step (after bodies woke) loses none of the first's.
+    pub fn restore_events(
+        &mut self,
+        (events, sensor_events): (Vec<CollisionEvent>, Vec<SensorEvent>),
+    ) {
+        let later = std::mem::replace(&mut self.events, events);
+        self.events.extend(later);
+        let later = std::mem::replace(&mut self.sensor_events, sensor_events);
+        self.sensor_events.extend(later);
+    }
+
+    /// The sensor events of the last update.
+    pub fn sensor_events(&self) -> &[SensorEvent] {
+        &self.sensor_events
+    }
+
+    /// The colliders overlapping each sensor at the last update: (sensor, other), sorted.
+    pub fn sensor_overlaps(&self) -> &[(ColliderHandle, ColliderHandle)] {
+        &self.overlaps
+    }
+
     /// Number of pairs with persistent state.
     pub fn pair_count(&self) -> usize {
         self.pairs.len()
@@ -473,6 +534,8 @@ impl NarrowPhase {
         let min_cos = settings.frame_angle_tolerance.cos();
         let mut touching = std::mem::take(&mut self.touching_scratch);
         touching.clear();
+        let mut overlaps = std::mem::take(&mut self.overlaps_scratch);
+        overlaps.clear();
 
         let mut old_pairs = std::mem::replace(&mut self.pairs, std::mem::take(&mut self.spare));
         self.pairs.clear();
@@ -495,7 +558,29 @@ impl NarrowPhase {
                 // Non-finite state is the facade's to report; it must not reach parry.
                 continue;
             }
+            if !c1.groups.meets(&c2.groups) {
+                continue;
+            }
             let pos12 = pose1.inv_mul(&pose2);
+            if c1.sensor || c2.sensor {
+                // No contact: only whether they overlap (an unsupported pair of shapes never
+                // does).
+                let overlapping = parry3d::query::intersection_test(
+                    &Pose::IDENTITY,
+                    c1.shape.as_ref(),
+                    &pos12,
+                    c2.shape.as_ref(),
+                )
+                .is_ok_and(|i| i.intersecting);
+                if overlapping {
+                    overlaps.push(if c1.sensor {
+                        (pair.0, pair.1)
+                    } else {
+                        (pair.1, pair.0)
+                    });
+                }
+                continue;
+            }
             if reusable(&state, &pos12, (shape_id(c1), shape_id(c2)), settings) {
                 for m in &mut state.manifolds {
                     m.update_separations(&manifold_pos12(m, &pos12));
@@ -577,7 +662,59 @@ impl NarrowPhase {
         self.spare = old_pairs;
         stats.contact_points = self.contacts.len();
         self.update_events(touching, bodies);
+        self.update_sensor_events(overlaps, colliders, bodies);
         stats
+    }
+
+    /// Diffs the overlapping sensor pairs against the previous update's; as for contacts, a
+    /// pair whose bodies are both at rest (asleep or fixed) keeps overlapping.
+    fn update_sensor_events(
+        &mut self,
+        mut overlaps: Vec<(ColliderHandle, ColliderHandle)>,
+        colliders: &ColliderSet,
+        bodies: &BodySet,
+    ) {
+        let frozen = |&(a, b): &(ColliderHandle, ColliderHandle)| {
+            let (Some(ca), Some(cb)) = (colliders.get(a), colliders.get(b)) else {
+                return false;
+            };
+            let still = (ca.sensor || cb.sensor) && ca.groups.meets(&cb.groups);
+            match (bodies.get(ca.body), bodies.get(cb.body)) {
+                (Some(x), Some(y)) => still && !x.is_awake() && !y.is_awake(),
+                _ => false,
+            }
+        };
+        overlaps.extend(self.overlaps.iter().copied().filter(frozen));
+        overlaps.sort_unstable();
+        overlaps.dedup();
+        self.sensor_events.clear();
+        let (old, new) = (&self.overlaps, &overlaps);
+        let (mut i, mut j) = (0, 0);
+        loop {
+            match (old.get(i), new.get(j)) {
+                (Some(o), Some(n)) if o == n => {
+                    i += 1;
+                    j += 1;
+                }
+                (Some(&(sensor, other)), Some(n)) if (sensor, other) < *n => {
+                    self.sensor_events
+                        .push(SensorEvent::Exited { sensor, other });
+                    i += 1;
+                }
+                (Some(&(sensor, other)), None) => {
+                    self.sensor_events
+                        .push(SensorEvent::Exited { sensor, other });
+                    i += 1;
+                }
+                (_, Some(&(sensor, other))) => {
+                    self.sensor_events
+                        .push(SensorEvent::Entered { sensor, other });
+                    j += 1;
+                }
+                (None, None) => break,
+            }
+        }
+        self.overlaps_scratch = std::mem::replace(&mut self.overlaps, overlaps);
     }
 
     /// Diffs the touching body pairs against the previous update's. A pair that left the

@@ -16,6 +16,7 @@
 
 use crate::broad_phase::BroadPhase;
 use crate::collider::{Collider, ColliderHandle, ColliderSet};
+use crate::groups::CollisionGroups;
 use jostle_body::{BodyHandle, BodySet, RigidBody};
 use jostle_math::Vec3;
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
@@ -79,6 +80,10 @@ pub struct QueryFilter {
     pub skip_fixed: bool,
     /// Skip colliders of bodies that can move (awake or asleep).
     pub skip_dynamic: bool,
+    /// Also report sensors ([`crate::Collider::sensor`]); skipped by default.
+    pub include_sensors: bool,
+    /// Only colliders whose groups meet these ([`CollisionGroups::meets`]); `None`: any.
+    pub groups: Option<CollisionGroups>,
 }
 
 impl QueryFilter {
@@ -90,7 +95,14 @@ impl QueryFilter {
         }
     }
 
-    /// Whether a collider of `handle`'s `body` passes.
+    /// Whether `collider`, on `body`, passes.
+    pub fn accepts_collider(&self, collider: &Collider, body: &RigidBody) -> bool {
+        (self.include_sensors || !collider.sensor)
+            && self.groups.is_none_or(|g| g.meets(&collider.groups))
+            && self.accepts(collider.body, body)
+    }
+
+    /// Whether a collider of `handle`'s `body` passes (the body tests only).
     pub fn accepts(&self, handle: BodyHandle, body: &RigidBody) -> bool {
         let skipped = if body.is_fixed() {
             self.skip_fixed
@@ -154,7 +166,7 @@ impl<'a> Queries<'a> {
     fn candidate(&self, handle: ColliderHandle, filter: &QueryFilter) -> Option<Candidate<'a>> {
         let collider = self.colliders.get(handle)?;
         let body = self.bodies.get(collider.body)?;
-        filter.accepts(collider.body, body).then(|| Candidate {
+        filter.accepts_collider(collider, body).then(|| Candidate {
             handle,
             collider,
             pose: collider.world_pose(body),
