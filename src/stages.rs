@@ -20,6 +20,9 @@ const NO_SOLVER: u32 = u32::MAX;
 pub(crate) struct Scratch {
     /// Dense solver bodies; index 0 is the static entry.
     pub bodies: Vec<SolverBody>,
+    /// By body slot: how fast the step changed the body's pose, (|Δx|² + |Δθ|²)/dt² (for
+    /// sleep, [`jostle_sleep::update_motion`]).
+    pub moved: Vec<f32>,
     /// Solver contacts.
     pub contacts: Vec<Contact>,
     /// For each solver contact, its index in the narrow phase's contact list.
@@ -564,9 +567,13 @@ fn rewound_velocity(v: Vec3, a: Vec3, moved: Vec3, dropped: f32) -> Vec3 {
 pub(crate) fn scatter(
     bodies: &mut BodySet,
     narrow: &mut NarrowPhase,
-    scratch: &Scratch,
+    scratch: &mut Scratch,
     report: &mut StepReport,
+    dt: f32,
 ) {
+    scratch.moved.clear();
+    scratch.moved.resize(bodies.capacity_index(), 0.0);
+    let inv_dt = 1.0 / dt;
     for (solver, &slot) in scratch.bodies.iter().zip(&scratch.body_slot).skip(1) {
         let Some((handle, _)) = bodies.by_index(slot) else {
             continue;
@@ -583,6 +590,10 @@ pub(crate) fn scatter(
             report.quarantined.push((handle, body.name.clone()));
             continue;
         }
+        let turned = solver.orientation.angle_between(body.orientation);
+        scratch.moved[slot as usize] = ((solver.position - body.position) * inv_dt)
+            .length_squared()
+            + (turned * inv_dt).powi(2);
         body.position = solver.position;
         body.orientation = solver.orientation;
         body.linear_velocity = solver.linear_velocity;
@@ -615,6 +626,7 @@ pub(crate) fn sleep(
     contacts: &[BodyContact],
     settings: &SleepSettings,
     dt: f32,
+    moved: &[f32],
     p: &mut StepProfile,
 ) {
     // With sleeping disabled no island can go to sleep, so none is looked for (bodies that
@@ -629,7 +641,9 @@ pub(crate) fn sleep(
         let mut qualifies = vec![false; bodies.capacity_index()];
         for (h, body) in bodies.iter_mut() {
             if body.is_awake() && !body.is_kinematic() {
-                qualifies[h.index() as usize] = update_motion(body, settings, dt);
+                let i = h.index() as usize;
+                qualifies[i] =
+                    update_motion(body, settings, dt, moved.get(i).copied().unwrap_or(0.0));
             }
         }
         islands.update(bodies, contacts.iter().map(|c| (c.a, c.b)), &qualifies);

@@ -1144,8 +1144,9 @@ impl World {
         stages::scatter(
             &mut self.bodies,
             &mut self.narrow,
-            &self.scratch,
+            &mut self.scratch,
             &mut report,
+            dt,
         );
         p.scatter = t.elapsed();
 
@@ -1156,6 +1157,7 @@ impl World {
             self.narrow.contacts(),
             &self.settings.sleep,
             dt,
+            &self.scratch.moved,
             &mut p,
         );
         p.sleep = t.elapsed();

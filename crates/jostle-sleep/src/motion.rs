@@ -4,10 +4,14 @@ use crate::SleepSettings;
 use jostle_body::RigidBody;
 
 /// Updates `body`'s motion average after a step of `dt` and returns whether it now qualifies
-/// for sleep: motion ← bias·motion + (1 − bias)·(|v|² + |ω|²) with bias = base^dt, capped at
-/// 10·ε; qualifies when motion < ε and the body may sleep.
-pub fn update_motion(body: &mut RigidBody, settings: &SleepSettings, dt: f32) -> bool {
-    let current = body.linear_velocity.length_squared() + body.angular_velocity.length_squared();
+/// for sleep: motion ← bias·motion + (1 − bias)·max(|v|² + |ω|², moved) with bias = base^dt,
+/// capped at 10·ε; qualifies when motion < ε and the body may sleep. `moved` is the square of
+/// how fast the step changed the body's pose, (|Δx|² + |Δθ|²)/dt²: a body that a resolver
+/// pushes out of overlap without giving it velocity (split impulses, projection) is moving,
+/// and must not fall asleep still overlapping.
+pub fn update_motion(body: &mut RigidBody, settings: &SleepSettings, dt: f32, moved: f32) -> bool {
+    let speed = body.linear_velocity.length_squared() + body.angular_velocity.length_squared();
+    let current = speed.max(moved);
     let bias = settings.bias_base.powf(dt);
     let motion = bias * body.sleep.motion + (1.0 - bias) * current;
     body.sleep.motion = motion.min(10.0 * settings.threshold);
@@ -39,7 +43,9 @@ mod tests {
         let s = SleepSettings::default();
         let mut b = RigidBody::dynamic(1.0, Mat3::IDENTITY).unwrap();
         wake(&mut b, &s);
-        (1..10_000).find(|_| update_motion(&mut b, &s, dt)).unwrap()
+        (1..10_000)
+            .find(|_| update_motion(&mut b, &s, dt, 0.0))
+            .unwrap()
     }
 
     #[test]
@@ -57,7 +63,7 @@ mod tests {
         let s = SleepSettings::default();
         let mut b = RigidBody::dynamic(1.0, Mat3::IDENTITY).unwrap();
         b.linear_velocity = Vec3::new(100.0, 0.0, 0.0);
-        update_motion(&mut b, &s, 1.0);
+        update_motion(&mut b, &s, 1.0, 0.0);
         assert_eq!(b.sleep.motion, 10.0 * s.threshold);
     }
 
@@ -67,6 +73,6 @@ mod tests {
         let mut b = RigidBody::dynamic(1.0, Mat3::IDENTITY).unwrap();
         b.sleep.can_sleep = false;
         b.sleep.motion = 0.0;
-        assert!(!update_motion(&mut b, &s, 1.0 / 60.0));
+        assert!(!update_motion(&mut b, &s, 1.0 / 60.0, 0.0));
     }
 }
