@@ -113,6 +113,10 @@ pub struct BodyDesc {
     pub sensor: bool,
     /// Which colliders it meets ([`CollisionGroups`]). Default: all.
     pub groups: CollisionGroups,
+    /// Report contact force events when its contacts with another collider push with more
+    /// than this total normal force in a step (N; [`crate::World::contact_force_events`]).
+    /// Default: none.
+    pub force_event_threshold: Option<f32>,
 }
 
 /// How a kinematic body moves ([`BodyDesc::kinematic`], scene field `kinematic`). Its mass
@@ -200,6 +204,7 @@ impl BodyDesc {
             kinematic: None,
             sensor: false,
             groups: CollisionGroups::ALL,
+            force_event_threshold: None,
         }
     }
 
@@ -253,6 +258,12 @@ impl BodyDesc {
     /// Sets the collision groups ([`BodyDesc::groups`]).
     pub fn with_groups(mut self, groups: CollisionGroups) -> Self {
         self.groups = groups;
+        self
+    }
+
+    /// Reports contact force events above `threshold` (N) ([`BodyDesc::force_event_threshold`]).
+    pub fn with_force_events(mut self, threshold: f32) -> Self {
+        self.force_event_threshold = Some(threshold);
         self
     }
 
@@ -364,6 +375,9 @@ impl BodyDesc {
         check_material(&self.material).map_err(|(field, message)| err(field, message))?;
         non_negative("linear_damping", self.linear_damping)?;
         non_negative("angular_damping", self.angular_damping)?;
+        if let Some(t) = self.force_event_threshold {
+            non_negative("force_event_threshold", t)?;
+        }
         if !self.fixed {
             check_mass(self.mass).map_err(|(field, message)| err(field, message))?;
         }

@@ -42,8 +42,9 @@ pub use body_desc::{
 };
 pub use jostle_body::{BodyHandle, BodyType, CcdMode, KinematicPath, RigidBody};
 pub use jostle_collide::{
-    BodyContact, CollideSettings, CollisionEvent, CollisionGroups, Combine, DisplayMesh, Material,
-    PointHit, Pose, Queries, QueryFilter, RayHit, SensorEvent, ShapeDesc, ShapeHit, SharedShape,
+    BodyContact, CollideSettings, Collider, CollisionEvent, CollisionGroups, Combine,
+    ContactForceEvent, DisplayMesh, Material, PairFilter, PointHit, Pose, Queries, QueryFilter,
+    RayHit, SensorEvent, ShapeDesc, ShapeHit, SharedShape,
 };
 pub use jostle_math::{Mat3, Quat, Vec3};
 pub use jostle_resolve::soft_step::team::set_threads;

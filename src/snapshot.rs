@@ -28,6 +28,12 @@ pub struct ColliderRecord {
     /// Whether it is a sensor (default: no).
     #[cfg_attr(feature = "serde", serde(default))]
     pub sensor: bool,
+    /// Contact force event threshold (N; default none).
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Option::is_none")
+    )]
+    pub force_event_threshold: Option<f32>,
 }
 
 #[cfg(feature = "scene")]
@@ -257,6 +263,7 @@ mod file {
                             body: c.body,
                             groups: c.groups,
                             sensor: c.sensor,
+                            force_event_threshold: c.force_event_threshold,
                         })
                     })
                     .unwrap_or_else(|never| match never {}),
@@ -326,6 +333,13 @@ mod file {
                         m.restitution
                     )));
                 }
+                if let Some(t) = record.force_event_threshold
+                    && !(t.is_finite() && t >= 0.0)
+                {
+                    return Err(invalid(format!(
+                        "collider {i}: force_event_threshold: must be finite and >= 0, got {t}"
+                    )));
+                }
                 let pose = record.local_pose;
                 let reach = pose.translation.abs().max_element();
                 let within = reach <= jostle_collide::shape::MAX_EXTENT;
@@ -351,7 +365,8 @@ mod file {
                     .with_local_pose(record.local_pose)
                     .with_material(record.material)
                     .with_groups(record.groups)
-                    .with_sensor(record.sensor))
+                    .with_sensor(record.sensor)
+                    .with_force_event_threshold(record.force_event_threshold))
             })?;
             world.colliders = ColliderSet::from_arena(colliders);
             let inv_mass = |c: &Collider| world.bodies.get(c.body).map_or(0.0, |b| b.inv_mass());

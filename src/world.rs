@@ -14,7 +14,8 @@ use crate::stages::{self, Scratch};
 use jostle_body::{BodyHandle, BodySet, BodyType, CcdMode, KinematicPath, RigidBody};
 use jostle_collide::{
     BodyContact, BroadPhase, Collider, ColliderHandle, ColliderSet, CollisionEvent,
-    CollisionGroups, Material, NarrowPhase, Queries, QueryFilter, RayHit, SensorEvent,
+    CollisionGroups, ContactForceEvent, Material, NarrowPhase, PairFilter, Queries, QueryFilter,
+    RayHit, SensorEvent,
 };
 use jostle_math::{Quat, Vec3};
 use jostle_resolve::{Resolver, StepContext};
@@ -101,6 +102,8 @@ pub struct World {
     /// Whether any body was given a path ([`World::set_path`]): then each step sends the
     /// bodies that have one along it.
     pub(crate) paths: bool,
+    /// The user's pair filter ([`World::set_pair_filter`]); not kept in snapshots.
+    pair_filter: Option<Box<PairFilter>>,
 }
 
 impl World {
@@ -122,6 +125,7 @@ impl World {
             stamp: 1,
             query_stamp: 0,
             paths: false,
+            pair_filter: None,
         }
     }
 
@@ -204,7 +208,8 @@ impl World {
                 .with_local_pose(local_pose)
                 .with_material(desc.material)
                 .with_groups(desc.groups)
-                .with_sensor(desc.sensor),
+                .with_sensor(desc.sensor)
+                .with_force_event_threshold(desc.force_event_threshold),
         );
         Ok(handle)
     }
@@ -530,6 +535,59 @@ impl World {
         let body = collider.body;
         self.wake_around(body);
         self.stamp += 1;
+        Ok(())
+    }
+
+    /// Asks `filter` which collider pairs may make contact (or report sensor events), after
+    /// their groups ([`PairFilter`]); `None` removes it. Every body wakes, so that pairs the
+    /// new filter refuses part and pairs it admits meet. A snapshot does not keep the filter:
+    /// set it again on the restored world.
+    ///
+    /// ```
+    /// use jostle::{BodyDesc, ShapeDesc, Vec3, World, WorldSettings};
+    ///
+    /// let mut world = World::new(WorldSettings::default());
+    /// world.add_body(BodyDesc::fixed("ground", ShapeDesc::HalfSpace { normal: Vec3::Y })).unwrap();
+    /// let ghost = world
+    ///     .add_body(BodyDesc::dynamic("ghost", ShapeDesc::Ball { radius: 0.5 }).at(Vec3::new(0.0, 0.5, 0.0)))
+    ///     .unwrap();
+    /// // The ghost's collider makes no contact with anything.
+    /// let ghost_collider = world.colliders_of(ghost)[0];
+    /// world.set_pair_filter(Some(Box::new(move |a: &jostle::Collider, b: &jostle::Collider| {
+    ///     a.body != ghost && b.body != ghost
+    /// })));
+    /// for _ in 0..60 {
+    ///     world.step(1.0 / 60.0).unwrap();
+    /// }
+    /// assert!(world.body(ghost).unwrap().position.y < -1.0, "it fell through the ground");
+    /// # let _ = ghost_collider;
+    /// ```
+    pub fn set_pair_filter(&mut self, filter: Option<Box<PairFilter>>) {
+        self.pair_filter = filter;
+        self.wake_all();
+    }
+
+    /// Sets the normal force (N) above which a collider's contacts with another in a step are
+    /// reported ([`World::contact_force_events`]); `None` stops them. Refused unless finite
+    /// and ≥ 0.
+    pub fn set_force_event_threshold(
+        &mut self,
+        handle: ColliderHandle,
+        threshold: Option<f32>,
+    ) -> Result<(), StepError> {
+        if let Some(t) = threshold
+            && !(t.is_finite() && t >= 0.0)
+        {
+            return Err(invalid((
+                "force_event_threshold",
+                format!("must be finite and >= 0, got {t}"),
+            )));
+        }
+        let collider = self
+            .colliders
+            .get_mut(handle)
+            .ok_or(StepError::InvalidCollider(handle))?;
+        collider.force_event_threshold = threshold;
         Ok(())
     }
 
@@ -943,6 +1001,12 @@ impl World {
         self.narrow.events()
     }
 
+    /// Collider pairs whose contacts pushed harder than their threshold in the last step
+    /// ([`World::set_force_event_threshold`]).
+    pub fn contact_force_events(&self) -> &[ContactForceEvent] {
+        self.narrow.force_events()
+    }
+
     /// Colliders that started or stopped overlapping a sensor in the last step.
     pub fn sensor_events(&self) -> &[SensorEvent] {
         self.narrow.sensor_events()
@@ -1148,6 +1212,7 @@ impl World {
             &mut report,
             dt,
         );
+        self.narrow.find_force_events(&self.colliders, dt);
         p.scatter = t.elapsed();
 
         let t = Instant::now();
@@ -1182,9 +1247,13 @@ impl World {
         p.broad_phase += t.elapsed();
         p.candidate_pairs = pairs.len();
         let t = Instant::now();
-        let stats =
-            self.narrow
-                .update(pairs, &self.colliders, &self.bodies, &self.settings.collide);
+        let stats = self.narrow.update_filtered(
+            pairs,
+            &self.colliders,
+            &self.bodies,
+            &self.settings.collide,
+            self.pair_filter.as_deref(),
+        );
         p.narrow_phase += t.elapsed();
         p.manifolds = stats.manifolds;
         p.manifolds_reused = stats.manifolds_reused;

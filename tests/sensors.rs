@@ -360,3 +360,121 @@ fn the_contact_that_wakes_a_sleeper_is_reported() {
         "the ball's landing on the sleeper is reported once"
     );
 }
+
+/// Contact force events: a 10 kg box resting on the ground pushes with m·g each step; with a
+/// threshold below that every step reports it (the total impulse m·g·dt up on the box, the
+/// strongest point on its bottom face), with one above it nothing does until a 30 kg box is
+/// set on top, after which the pair carries (10 + 30)·g. The force is the one the contacts
+/// carry at the end of the step (for the soft step, its last substep's impulse over the
+/// substep), not the peak of an impact inside the step.
+#[test]
+fn contact_force_events_report_what_pushes_harder_than_the_threshold() {
+    for resolver in common::resolvers() {
+        let name = resolver.name();
+        for threshold in [50.0, 200.0] {
+            // Sleeping pairs are not solved and report nothing: sleep off.
+            let mut settings = WorldSettings {
+                resolver: resolver.clone(),
+                ..Default::default()
+            };
+            settings.sleep.enabled = false;
+            let mut w = World::new(settings);
+            let ground = w
+                .add_body(BodyDesc::fixed(
+                    "ground",
+                    ShapeDesc::HalfSpace { normal: Vec3::Y },
+                ))
+                .unwrap();
+            let half = Vec3::new(0.25, 0.1, 0.2);
+            let cuboid = ShapeDesc::Cuboid { half_extents: half };
+            let boxed = w
+                .add_body(
+                    BodyDesc::dynamic("box", cuboid.clone())
+                        .at(Vec3::new(0.0, 0.1, 0.0))
+                        .with_mass(10.0)
+                        .with_force_events(threshold),
+                )
+                .unwrap();
+            // Steps 61–119 against the ground, 181–239 against the ground and the load.
+            let mut reported = [0u32; 4];
+            for step in 1..=240 {
+                if step == 121 {
+                    w.add_body(
+                        BodyDesc::dynamic("load", cuboid.clone())
+                            .at(Vec3::new(0.0, 0.3, 0.0))
+                            .with_mass(30.0),
+                    )
+                    .unwrap();
+                }
+                w.step(DT).unwrap();
+                let carried: f32 = if step <= 120 { 10.0 } else { 40.0 } * 9.81;
+                for e in w.contact_force_events() {
+                    assert!(e.total_force > threshold, "{name}: {e:?}");
+                    assert_eq!(e.a, boxed, "{name}: the box has the threshold: {e:?}");
+                    // The ground pushes the box up with what it carries; the load pushes it
+                    // down with its own weight.
+                    let (pushed, which): (f32, usize) = if e.b == ground {
+                        (carried, 0)
+                    } else {
+                        (-30.0 * 9.81, 2)
+                    };
+                    if step % 120 > 60 {
+                        assert!(
+                            (e.total_force - pushed.abs()).abs() < 0.05 * pushed.abs(),
+                            "{name}, step {step}: force {} against {pushed}",
+                            e.total_force
+                        );
+                        let on_box = e.total_impulse / DT;
+                        assert!(
+                            (on_box - Vec3::new(0.0, pushed, 0.0)).length() < 0.05 * pushed.abs(),
+                            "{name}: {on_box}"
+                        );
+                        let face = if which == 0 { 0.0 } else { 0.2 };
+                        assert!((e.strongest_point.y - face).abs() < 0.01, "{name}: {e:?}");
+                        assert!(e.strongest_force <= e.total_force + 1e-3);
+                        reported[which + (step > 120) as usize] += 1;
+                    }
+                }
+            }
+            // The ground carries 98 N, then 392 N; the load weighs 294 N on the box: each
+            // reported when above the threshold.
+            let expected = [if threshold < 98.1 { 59 } else { 0 }, 59, 0, 59];
+            assert_eq!(reported, expected, "{name}, threshold {threshold}");
+        }
+    }
+}
+
+/// A pair filter refuses the pairs it is asked about: a box it keeps from the ground falls
+/// through; the other box lands. A snapshot does not keep the filter.
+#[test]
+fn a_pair_filter_refuses_pairs() {
+    use jostle::Collider;
+    let mut w = world(ResolverChoice::default());
+    w.add_body(BodyDesc::fixed(
+        "ground",
+        ShapeDesc::HalfSpace { normal: Vec3::Y },
+    ))
+    .unwrap();
+    let cube = |name: &str, x: f32| {
+        BodyDesc::dynamic(
+            name,
+            ShapeDesc::Cuboid {
+                half_extents: Vec3::splat(0.5),
+            },
+        )
+        .at(Vec3::new(x, 1.0, 0.0))
+    };
+    let sinker = w.add_body(cube("sinker", 0.0)).unwrap();
+    let lander = w.add_body(cube("lander", 3.0)).unwrap();
+    w.set_pair_filter(Some(Box::new(move |a: &Collider, b: &Collider| {
+        a.body != sinker && b.body != sinker
+    })));
+    for _ in 0..60 {
+        w.step(DT).unwrap();
+    }
+    assert!(w.body(sinker).unwrap().position.y < -1.0);
+    assert!((w.body(lander).unwrap().position.y - 0.5).abs() < 0.01);
+    w.set_pair_filter(None);
+    let text = w.snapshot("filter", DT).to_ron().unwrap();
+    assert!(World::from_snapshot(Snapshot::parse(&text, "filter").unwrap()).is_ok());
+}

@@ -244,6 +244,9 @@ pub struct BodySpec {
     /// another when each one's memberships share a bit with the other's filter. Default: all.
     #[serde(default)]
     pub groups: jostle_collide::CollisionGroups,
+    /// Report contact force events above this total normal force (N). Default: none.
+    #[serde(default)]
+    pub force_event_threshold: Option<f32>,
 }
 
 fn identity() -> Quat {
@@ -289,6 +292,7 @@ impl BodySpec {
             kinematic: self.kinematic,
             sensor: self.sensor,
             groups: self.groups,
+            force_event_threshold: self.force_event_threshold,
         };
         desc.validate()?;
         Ok(desc)

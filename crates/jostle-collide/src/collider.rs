@@ -35,6 +35,9 @@ pub struct Collider {
     /// it ([`crate::SensorEvent`]) and lets them pass. CCD and, unless they ask for them,
     /// queries ignore it.
     pub sensor: bool,
+    /// Report a [`crate::ContactForceEvent`] for a step in which this collider's contacts
+    /// with another push with a total normal force above this (N); `None`: never.
+    pub force_event_threshold: Option<f32>,
     /// What CCD needs of the shape, computed whenever the shape or local pose is set.
     pub(crate) ccd: CcdShape,
     /// The description the shape was built from ([`Collider::from_desc`]), for snapshots.
@@ -66,6 +69,7 @@ impl Collider {
             body,
             groups: CollisionGroups::ALL,
             sensor: false,
+            force_event_threshold: None,
             ccd: CcdShape {
                 thickness: 0.0,
                 extent: 0.0,
@@ -103,6 +107,12 @@ impl Collider {
     /// Makes the collider a sensor (or not).
     pub fn with_sensor(mut self, sensor: bool) -> Self {
         self.sensor = sensor;
+        self
+    }
+
+    /// Sets the contact force event threshold ([`Collider::force_event_threshold`]).
+    pub fn with_force_event_threshold(mut self, threshold: Option<f32>) -> Self {
+        self.force_event_threshold = threshold;
         self
     }
 

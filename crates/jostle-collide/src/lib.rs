@@ -33,7 +33,10 @@ pub use display::DisplayMesh;
 pub use groups::CollisionGroups;
 pub use mass::{MassProps, mass_properties};
 pub use material::{Combine, Material};
-pub use narrow_phase::{BodyContact, CollisionEvent, NarrowPhase, NarrowStats, SensorEvent};
+pub use narrow_phase::{
+    BodyContact, CollisionEvent, ContactForceEvent, NarrowPhase, NarrowStats, PairFilter,
+    SensorEvent,
+};
 pub use parry3d;
 pub use parry3d::math::Pose;
 pub use parry3d::shape::SharedShape;

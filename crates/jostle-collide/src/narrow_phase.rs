@@ -100,6 +100,37 @@ pub enum SensorEvent {
     },
 }
 
+/// The contacts of a collider pair pushed harder than a threshold in a step
+/// ([`crate::Collider::force_event_threshold`], the smaller of the pair's when both have one).
+/// The force is what the contacts carry at the end of the step (a substepping resolver's last
+/// substep, over the step), not the peak of an impact inside it; a sleeping pair is not solved
+/// and reports nothing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct ContactForceEvent {
+    /// The collider on body `a`.
+    pub collider_a: ColliderHandle,
+    /// The collider on body `b`.
+    pub collider_b: ColliderHandle,
+    /// The body the impulses act on ([`BodyContact::a`]).
+    pub a: BodyHandle,
+    /// The other body.
+    pub b: BodyHandle,
+    /// The step's total contact impulse on `a` (N·s, world space: normal and friction).
+    pub total_impulse: Vec3,
+    /// The total normal force over the step (N): the normal impulses summed, over the step.
+    pub total_force: f32,
+    /// The contact point that carried the largest normal impulse (world, on `a`'s surface).
+    pub strongest_point: Vec3,
+    /// Its normal force (N).
+    pub strongest_force: f32,
+}
+
+/// A user's say on which collider pairs may make contact (or report sensor events), asked
+/// after their groups meet: `false` skips the pair. It must answer the same for the same
+/// pair until told otherwise, or contacts flicker.
+pub type PairFilter = dyn Fn(&Collider, &Collider) -> bool + Send + Sync;
+
 /// Counts of one narrow-phase update.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct NarrowStats {
@@ -226,6 +257,9 @@ pub struct NarrowPhase {
     /// Scratch for the overlapping pairs of an update.
     #[cfg_attr(feature = "serde", serde(skip))]
     overlaps_scratch: Vec<(ColliderHandle, ColliderHandle)>,
+    /// The contact force events of the last step ([`NarrowPhase::find_force_events`]).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    force_events: Vec<ContactForceEvent>,
 }
 
 impl std::fmt::Debug for NarrowPhase {
@@ -398,6 +432,69 @@ impl NarrowPhase {
         self.sensor_events.extend(later);
     }
 
+    /// The contact force events of the last step.
+    pub fn force_events(&self) -> &[ContactForceEvent] {
+        &self.force_events
+    }
+
+    /// After the contacts' impulses of a step of `dt` are stored ([`NarrowPhase::store_point`]):
+    /// an event for each collider pair with a threshold whose contacts pushed harder.
+    pub fn find_force_events(&mut self, colliders: &ColliderSet, dt: f32) {
+        self.force_events.clear();
+        let mut start = 0;
+        while start < self.contacts.len() {
+            let pair_index = self.slots[start].pair;
+            let mut end = start + 1;
+            while end < self.contacts.len() && self.slots[end].pair == pair_index {
+                end += 1;
+            }
+            let group = start..end;
+            start = end;
+            let Some(state) = self.pairs.get(pair_index as usize) else {
+                continue;
+            };
+            let (Some(c1), Some(c2)) = (colliders.get(state.pair.0), colliders.get(state.pair.1))
+            else {
+                continue;
+            };
+            let threshold = match (c1.force_event_threshold, c2.force_event_threshold) {
+                (Some(x), Some(y)) => x.min(y),
+                (Some(x), None) | (None, Some(x)) => x,
+                (None, None) => continue,
+            };
+            let contacts = &self.contacts[group];
+            let normal_impulse: f32 = contacts.iter().map(|c| c.impulse.x.max(0.0)).sum();
+            let total_force = normal_impulse / dt;
+            if total_force.is_nan() || total_force <= threshold {
+                continue;
+            }
+            let total_impulse = contacts
+                .iter()
+                .map(|c| jostle_math::contact_basis(c.normal) * c.impulse)
+                .fold(Vec3::ZERO, |sum, i| sum + i);
+            let strongest = contacts
+                .iter()
+                .max_by(|x, y| x.impulse.x.total_cmp(&y.impulse.x))
+                .expect("a group has a contact");
+            let first = contacts[0];
+            let (collider_a, collider_b) = if c1.body == first.a {
+                (state.pair.0, state.pair.1)
+            } else {
+                (state.pair.1, state.pair.0)
+            };
+            self.force_events.push(ContactForceEvent {
+                collider_a,
+                collider_b,
+                a: first.a,
+                b: first.b,
+                total_impulse,
+                total_force,
+                strongest_point: strongest.point,
+                strongest_force: strongest.impulse.x.max(0.0) / dt,
+            });
+        }
+    }
+
     /// The sensor events of the last update.
     pub fn sensor_events(&self) -> &[SensorEvent] {
         &self.sensor_events
@@ -517,6 +614,18 @@ impl NarrowPhase {
         bodies: &BodySet,
         settings: &CollideSettings,
     ) -> NarrowStats {
+        self.update_filtered(pairs, colliders, bodies, settings, None)
+    }
+
+    /// [`NarrowPhase::update`], skipping the pairs `filter` refuses ([`PairFilter`]).
+    pub fn update_filtered(
+        &mut self,
+        pairs: &[ColliderPair],
+        colliders: &ColliderSet,
+        bodies: &BodySet,
+        settings: &CollideSettings,
+        filter: Option<&PairFilter>,
+    ) -> NarrowStats {
         let pairs: Cow<[ColliderPair]> = if pairs.windows(2).all(|w| w[0] < w[1]) {
             Cow::Borrowed(pairs)
         } else {
@@ -558,7 +667,7 @@ impl NarrowPhase {
                 // Non-finite state is the facade's to report; it must not reach parry.
                 continue;
             }
-            if !c1.groups.meets(&c2.groups) {
+            if !c1.groups.meets(&c2.groups) || filter.is_some_and(|f| !f(c1, c2)) {
                 continue;
             }
             let pos12 = pose1.inv_mul(&pose2);
