@@ -424,6 +424,16 @@ impl World {
         Ok(())
     }
 
+    /// A finite position and the unit rotation of a finite non-zero quaternion, or the error
+    /// naming which is not.
+    fn checked_pose(position: Vec3, rotation: Quat) -> Result<Quat, StepError> {
+        Self::finite("position", position)?;
+        unit_rotation(rotation).ok_or_else(|| StepError::NonFinite {
+            what: "rotation",
+            value: format!("{rotation:?}"),
+        })
+    }
+
     /// Sets the pose of the centre of mass; wakes the body's island.
     pub fn set_pose(
         &mut self,
@@ -431,13 +441,7 @@ impl World {
         position: Vec3,
         rotation: Quat,
     ) -> Result<(), StepError> {
-        Self::finite("position", position)?;
-        let Some(unit) = unit_rotation(rotation) else {
-            return Err(StepError::NonFinite {
-                what: "rotation",
-                value: format!("{rotation:?}"),
-            });
-        };
+        let unit = Self::checked_pose(position, rotation)?;
         let body = self.body_mut_awake(handle)?;
         body.position = position;
         body.orientation = unit;
@@ -492,12 +496,7 @@ impl World {
         material: Material,
     ) -> Result<(), StepError> {
         check_material(&material).map_err(invalid)?;
-        let collider = self
-            .colliders
-            .get_mut(handle)
-            .ok_or(StepError::InvalidCollider(handle))?;
-        collider.material = material;
-        let body = collider.body;
+        let body = self.change_collider(handle, |c| c.material = material)?;
         self.islands
             .wake(&mut self.bodies, body, &self.settings.sleep);
         Ok(())
@@ -527,15 +526,24 @@ impl World {
     /// assert!(entered);
     /// ```
     pub fn set_sensor(&mut self, handle: ColliderHandle, sensor: bool) -> Result<(), StepError> {
+        let body = self.change_collider(handle, |c| c.sensor = sensor)?;
+        self.wake_around(body);
+        self.stamp += 1;
+        Ok(())
+    }
+
+    /// Applies `change` to a collider; returns its body.
+    fn change_collider(
+        &mut self,
+        handle: ColliderHandle,
+        change: impl FnOnce(&mut Collider),
+    ) -> Result<BodyHandle, StepError> {
         let collider = self
             .colliders
             .get_mut(handle)
             .ok_or(StepError::InvalidCollider(handle))?;
-        collider.sensor = sensor;
-        let body = collider.body;
-        self.wake_around(body);
-        self.stamp += 1;
-        Ok(())
+        change(collider);
+        Ok(collider.body)
     }
 
     /// Asks `filter` which collider pairs may make contact (or report sensor events), after
@@ -583,11 +591,7 @@ impl World {
                 format!("must be finite and >= 0, got {t}"),
             )));
         }
-        let collider = self
-            .colliders
-            .get_mut(handle)
-            .ok_or(StepError::InvalidCollider(handle))?;
-        collider.force_event_threshold = threshold;
+        self.change_collider(handle, |c| c.force_event_threshold = threshold)?;
         Ok(())
     }
 
@@ -598,12 +602,7 @@ impl World {
         handle: ColliderHandle,
         groups: CollisionGroups,
     ) -> Result<(), StepError> {
-        let collider = self
-            .colliders
-            .get_mut(handle)
-            .ok_or(StepError::InvalidCollider(handle))?;
-        collider.groups = groups;
-        let body = collider.body;
+        let body = self.change_collider(handle, |c| c.groups = groups)?;
         self.wake_around(body);
         Ok(())
     }
@@ -859,13 +858,7 @@ impl World {
         position: Vec3,
         rotation: Quat,
     ) -> Result<(), StepError> {
-        Self::finite("position", position)?;
-        let Some(unit) = unit_rotation(rotation) else {
-            return Err(StepError::NonFinite {
-                what: "rotation",
-                value: format!("{rotation:?}"),
-            });
-        };
+        let unit = Self::checked_pose(position, rotation)?;
         let body = self
             .bodies
             .get_mut(handle)

@@ -797,32 +797,14 @@ impl NarrowPhase {
         overlaps.sort_unstable();
         overlaps.dedup();
         self.sensor_events.clear();
-        let (old, new) = (&self.overlaps, &overlaps);
-        let (mut i, mut j) = (0, 0);
-        loop {
-            match (old.get(i), new.get(j)) {
-                (Some(o), Some(n)) if o == n => {
-                    i += 1;
-                    j += 1;
-                }
-                (Some(&(sensor, other)), Some(n)) if (sensor, other) < *n => {
-                    self.sensor_events
-                        .push(SensorEvent::Exited { sensor, other });
-                    i += 1;
-                }
-                (Some(&(sensor, other)), None) => {
-                    self.sensor_events
-                        .push(SensorEvent::Exited { sensor, other });
-                    i += 1;
-                }
-                (_, Some(&(sensor, other))) => {
-                    self.sensor_events
-                        .push(SensorEvent::Entered { sensor, other });
-                    j += 1;
-                }
-                (None, None) => break,
-            }
-        }
+        let events = &mut self.sensor_events;
+        diff_sorted(&self.overlaps, &overlaps, |&(sensor, other), now| {
+            events.push(if now {
+                SensorEvent::Entered { sensor, other }
+            } else {
+                SensorEvent::Exited { sensor, other }
+            });
+        });
         self.overlaps_scratch = std::mem::replace(&mut self.overlaps, overlaps);
     }
 
@@ -839,30 +821,42 @@ impl NarrowPhase {
         touching.dedup();
 
         self.events.clear();
-        let (old, new) = (&self.touching, &touching);
-        let (mut i, mut j) = (0, 0);
-        while i < old.len() || j < new.len() {
-            match (old.get(i), new.get(j)) {
-                (Some(o), Some(n)) if o == n => {
-                    i += 1;
-                    j += 1;
-                }
-                (Some(o), Some(n)) if o < n => {
-                    self.events.push(CollisionEvent::Stopped(o.0, o.1));
-                    i += 1;
-                }
-                (Some(o), None) => {
-                    self.events.push(CollisionEvent::Stopped(o.0, o.1));
-                    i += 1;
-                }
-                (_, Some(n)) => {
-                    self.events.push(CollisionEvent::Started(n.0, n.1));
-                    j += 1;
-                }
-                (None, None) => break,
-            }
-        }
+        let events = &mut self.events;
+        diff_sorted(&self.touching, &touching, |&(a, b), now| {
+            events.push(if now {
+                CollisionEvent::Started(a, b)
+            } else {
+                CollisionEvent::Stopped(a, b)
+            });
+        });
         self.touching_scratch = std::mem::replace(&mut self.touching, touching);
+    }
+}
+
+/// Walks two sorted, deduplicated lists together: `f(item, false)` for each item only in
+/// `old`, `f(item, true)` for each only in `new`, in order.
+fn diff_sorted<T: Ord>(old: &[T], new: &[T], mut f: impl FnMut(&T, bool)) {
+    let (mut i, mut j) = (0, 0);
+    loop {
+        match (old.get(i), new.get(j)) {
+            (Some(o), Some(n)) if o == n => {
+                i += 1;
+                j += 1;
+            }
+            (Some(o), Some(n)) if o < n => {
+                f(o, false);
+                i += 1;
+            }
+            (Some(o), None) => {
+                f(o, false);
+                i += 1;
+            }
+            (_, Some(n)) => {
+                f(n, true);
+                j += 1;
+            }
+            (None, None) => break,
+        }
     }
 }
 
