@@ -23,6 +23,8 @@ pub(crate) struct Scratch {
     /// By body slot: how fast the step changed the body's pose, (|Δx|² + |Δθ|²)/dt² (for
     /// sleep, [`jostle_sleep::update_motion`]).
     pub moved: Vec<f32>,
+    /// By body slot: whether the body qualifies for sleep this step.
+    pub qualifies: Vec<bool>,
     /// Solver contacts.
     pub contacts: Vec<Contact>,
     /// For each solver contact, its index in the narrow phase's contact list.
@@ -626,9 +628,12 @@ pub(crate) fn sleep(
     contacts: &[BodyContact],
     settings: &SleepSettings,
     dt: f32,
-    moved: &[f32],
+    scratch: &mut Scratch,
     p: &mut StepProfile,
 ) {
+    let Scratch {
+        moved, qualifies, ..
+    } = scratch;
     // With sleeping disabled no island can go to sleep, so none is looked for (bodies that
     // fell asleep before it was disabled keep their islands, which still wake together).
     // A kinematic body is awake while it moves; it never joins an island.
@@ -638,7 +643,8 @@ pub(crate) fn sleep(
         }
     }
     if settings.enabled {
-        let mut qualifies = vec![false; bodies.capacity_index()];
+        qualifies.clear();
+        qualifies.resize(bodies.capacity_index(), false);
         for (h, body) in bodies.iter_mut() {
             if body.is_awake() && !body.is_kinematic() {
                 let i = h.index() as usize;
@@ -646,7 +652,7 @@ pub(crate) fn sleep(
                     update_motion(body, settings, dt, moved.get(i).copied().unwrap_or(0.0));
             }
         }
-        islands.update(bodies, contacts.iter().map(|c| (c.a, c.b)), &qualifies);
+        islands.update(bodies, contacts.iter().map(|c| (c.a, c.b)), qualifies);
         p.islands_count = islands.awake_islands();
     }
     for (_, body) in bodies.iter() {

@@ -1215,7 +1215,7 @@ impl World {
             self.narrow.contacts(),
             &self.settings.sleep,
             dt,
-            &self.scratch.moved,
+            &mut self.scratch,
             &mut p,
         );
         p.sleep = t.elapsed();

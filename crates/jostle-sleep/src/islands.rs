@@ -17,9 +17,15 @@ pub struct UnionFind {
 impl UnionFind {
     /// `n` singleton sets.
     pub fn new(n: usize) -> Self {
-        Self {
-            parent: (0..n as u32).collect(),
-        }
+        let mut uf = Self::default();
+        uf.reset(n);
+        uf
+    }
+
+    /// Back to `n` singleton sets, keeping the allocation.
+    pub fn reset(&mut self, n: usize) {
+        self.parent.clear();
+        self.parent.extend(0..n as u32);
     }
 
     /// The root (smallest index) of `i`'s set.
@@ -52,6 +58,31 @@ pub struct IslandSet {
     sleeping: Vec<Option<Vec<BodyHandle>>>,
     /// Number of awake islands found by the last [`IslandSet::update`].
     awake_islands: usize,
+    /// Working arrays of [`IslandSet::update`], kept only to reuse their allocations.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    scratch: Scratch,
+}
+
+/// The working arrays of one [`IslandSet::update`].
+#[derive(Clone, Debug, Default)]
+struct Scratch {
+    uf: UnionFind,
+    /// By root slot: every member qualifies.
+    all_qualify: Vec<bool>,
+    /// By slot: a root of an awake island.
+    is_root: Vec<bool>,
+    /// The awake bodies and their roots, in slot order.
+    awake: Vec<(BodyHandle, u32)>,
+    /// By root slot: its index in `new_islands`.
+    island_of_root: Vec<Option<usize>>,
+    /// The islands going to sleep: root and members.
+    new_islands: Vec<(u32, Vec<BodyHandle>)>,
+}
+
+/// `v` as `n` copies of `value`, keeping its allocation.
+fn refill<T: Clone>(v: &mut Vec<T>, n: usize, value: T) {
+    v.clear();
+    v.resize(n, value);
 }
 
 impl IslandSet {
@@ -163,7 +194,15 @@ impl IslandSet {
     ) -> usize {
         let n = bodies.capacity_index();
         self.sleeping_of.resize(n, None);
-        let mut uf = UnionFind::new(n);
+        let Scratch {
+            uf,
+            all_qualify,
+            is_root,
+            awake,
+            island_of_root,
+            new_islands,
+        } = &mut self.scratch;
+        uf.reset(n);
         for (a, b) in touching {
             // Fixed and kinematic bodies never join islands.
             let awake = |h: BodyHandle| {
@@ -176,14 +215,16 @@ impl IslandSet {
             }
         }
         // all_qualify[root] = every member qualifies.
-        let mut all_qualify = vec![true; n];
-        let mut is_root = vec![false; n];
-        let awake: Vec<(BodyHandle, u32)> = bodies
-            .iter()
-            .filter(|(_, b)| b.is_awake() && !b.is_immovable())
-            .map(|(h, _)| (h, uf.find(h.index())))
-            .collect();
-        for &(h, root) in &awake {
+        refill(all_qualify, n, true);
+        refill(is_root, n, false);
+        awake.clear();
+        awake.extend(
+            bodies
+                .iter()
+                .filter(|(_, b)| b.is_awake() && !b.is_immovable())
+                .map(|(h, _)| (h, uf.find(h.index()))),
+        );
+        for &(h, root) in awake.iter() {
             is_root[root as usize] = true;
             if !qualifies.get(h.index() as usize).copied().unwrap_or(false) {
                 all_qualify[root as usize] = false;
@@ -191,9 +232,9 @@ impl IslandSet {
         }
         self.awake_islands = is_root.iter().filter(|&&r| r).count();
         // Group sleeping islands in slot order (deterministic).
-        let mut new_islands: Vec<(u32, Vec<BodyHandle>)> = Vec::new();
-        let mut island_of_root: Vec<Option<usize>> = vec![None; n];
-        for &(h, root) in &awake {
+        new_islands.clear();
+        refill(island_of_root, n, None);
+        for &(h, root) in awake.iter() {
             if all_qualify[root as usize] {
                 let idx = *island_of_root[root as usize].get_or_insert_with(|| {
                     new_islands.push((root, Vec::new()));
@@ -203,7 +244,7 @@ impl IslandSet {
             }
         }
         let mut slept = 0;
-        for (_, members) in new_islands {
+        for (_, members) in new_islands.drain(..) {
             let id = match self.sleeping.iter().position(|s| s.is_none()) {
                 Some(free) => free,
                 None => {
