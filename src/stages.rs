@@ -20,8 +20,8 @@ const NO_SOLVER: u32 = u32::MAX;
 pub(crate) struct Scratch {
     /// Dense solver bodies; index 0 is the static entry.
     pub bodies: Vec<SolverBody>,
-    /// By body slot: how fast the step changed the body's pose, (|Δx|² + |Δθ|²)/dt² (for
-    /// sleep, [`jostle_sleep::update_motion`]).
+    /// By body slot: how fast the step changed the body's pose, (|Δx|² + (2·sin(Δθ/2))²)/dt²
+    /// (for sleep, [`jostle_sleep::update_motion`]).
     pub moved: Vec<f32>,
     /// By body slot: whether the body qualifies for sleep this step.
     pub qualifies: Vec<bool>,
@@ -592,10 +592,12 @@ pub(crate) fn scatter(
             report.quarantined.push((handle, body.name.clone()));
             continue;
         }
-        let turned = solver.orientation.angle_between(body.orientation);
-        scratch.moved[slot as usize] = ((solver.position - body.position) * inv_dt)
-            .length_squared()
-            + (turned * inv_dt).powi(2);
+        // (2·sin(Δθ/2))² = 4·(1 − cos²(Δθ/2)), Δθ² to second order, without an acos.
+        let cos_half = solver.orientation.dot(body.orientation);
+        let turned_sq = 4.0 * (1.0 - cos_half * cos_half).max(0.0);
+        scratch.moved[slot as usize] =
+            (solver.position - body.position).length_squared() * inv_dt * inv_dt
+                + turned_sq * inv_dt * inv_dt;
         body.position = solver.position;
         body.orientation = solver.orientation;
         body.linear_velocity = solver.linear_velocity;
