@@ -6,7 +6,8 @@ use jostle_body::RigidBody;
 /// Updates `body`'s motion average after a step of `dt` and returns whether it now qualifies
 /// for sleep: motion ← bias·motion + (1 − bias)·max(|v|² + |ω|², moved) with bias = base^dt,
 /// capped at 10·ε; qualifies when motion < ε and the body may sleep. `moved` is the square of
-/// how fast the step changed the body's pose, (|Δx|² + |Δθ|²)/dt²: a body that a resolver
+/// how fast the step changed the body's pose, (|Δx|² + Δθ²)/dt² (the world uses
+/// (2·sin(Δθ/2))² for Δθ²): a body that a resolver
 /// pushes out of overlap without giving it velocity (split impulses, projection) is moving,
 /// and must not fall asleep still overlapping.
 pub fn update_motion(body: &mut RigidBody, settings: &SleepSettings, dt: f32, moved: f32) -> bool {
