@@ -478,3 +478,50 @@ fn a_pair_filter_refuses_pairs() {
     let text = w.snapshot("filter", DT).to_ron().unwrap();
     assert!(World::from_snapshot(Snapshot::parse(&text, "filter").unwrap()).is_ok());
 }
+
+/// A kinematic body moving through a fixed sensor is reported entering and leaving it (two
+/// immovable colliders make no contact, but a sensor still sees them).
+#[test]
+fn a_fixed_sensor_sees_a_kinematic_body_pass() {
+    use jostle::BodyType;
+    let mut w = world(ResolverChoice::default());
+    let zone = w.add_body(slab("zone", 0.0).as_sensor()).unwrap();
+    let platform = w
+        .add_body(
+            BodyDesc::dynamic(
+                "platform",
+                ShapeDesc::Cuboid {
+                    half_extents: Vec3::splat(0.25),
+                },
+            )
+            .at(Vec3::new(-4.0, 0.0, 0.0)),
+        )
+        .unwrap();
+    w.set_body_type(platform, BodyType::KinematicVelocity)
+        .unwrap();
+    w.set_velocity(platform, Vec3::new(2.0, 0.0, 0.0), Vec3::ZERO)
+        .unwrap();
+    let zone_collider = w.colliders_of(zone)[0];
+    let mut seen = Vec::new();
+    for step in 1..=240 {
+        w.step(DT).unwrap();
+        for e in w.sensor_events() {
+            seen.push((step, *e));
+        }
+    }
+    let platform_collider = w.colliders_of(platform)[0];
+    assert_eq!(seen.len(), 2, "{seen:?}");
+    assert_eq!(
+        seen[0].1,
+        SensorEvent::Entered {
+            sensor: zone_collider,
+            other: platform_collider
+        }
+    );
+    assert!(matches!(seen[1].1, SensorEvent::Exited { .. }));
+    // It enters when its front face (x + 0.25) reaches −2 (t = 0.875 s, after 52.5 steps)
+    // and leaves when its back face passes +2 (t = 3.125 s, after 187.5 steps); a step
+    // reports what it found at the poses it started from.
+    assert!((53..=55).contains(&seen[0].0), "{seen:?}");
+    assert!((188..=190).contains(&seen[1].0), "{seen:?}");
+}

@@ -42,14 +42,23 @@ impl ColliderPair {
     }
 }
 
+/// Whether neither collider can move nor is a sensor: such a pair never makes a contact
+/// (a sensor still reports a kinematic body passing through it).
+fn both_static(a: &Proxy, b: &Proxy) -> bool {
+    a.immovable && b.immovable && !a.sensor && !b.sensor
+}
+
 /// What the broad phase remembers of one collider slot.
 #[derive(Clone, Debug)]
 struct Proxy {
     generation: u32,
     body: BodyHandle,
     awake: bool,
-    /// Its body is fixed or kinematic: no pair of two such colliders is a candidate.
+    /// Its body is fixed or kinematic: no pair of two such colliders is a candidate, unless
+    /// one is a sensor ([`both_static`]).
     immovable: bool,
+    /// The collider is a sensor.
+    sensor: bool,
     unbounded: bool,
     /// World outward normal of an unbounded (half-space) collider; zero otherwise.
     normal: Vec3,
@@ -311,6 +320,7 @@ impl BroadPhase {
                     body: collider.body,
                     awake,
                     immovable,
+                    sensor: collider.sensor,
                     unbounded,
                     normal,
                     pose,
@@ -325,6 +335,7 @@ impl BroadPhase {
             };
             p.awake = awake;
             p.immovable = immovable;
+            p.sensor = collider.sensor;
             p.body = collider.body;
             if p.unbounded {
                 self.unbounded.push(i);
@@ -489,7 +500,7 @@ impl BroadPhase {
                     continue;
                 };
                 if !(pi.awake || pj.awake)
-                    || (pi.immovable && pj.immovable)
+                    || both_static(pi, pj)
                     || pi.body == pj.body
                     || !pi.aabb.intersects(&pj.aabb)
                 {
@@ -521,7 +532,7 @@ impl BroadPhase {
                 };
                 // Awake–awake pairs are found from both sides: keep the one from the lower slot.
                 if (pj.awake && j < i)
-                    || (pi.immovable && pj.immovable)
+                    || both_static(pi, pj)
                     || pj.body == pi.body
                     || !pi.aabb.intersects(&pj.aabb)
                 {
@@ -544,7 +555,7 @@ impl BroadPhase {
             let test = |_j: u32, pj: &Proxy| {
                 pj.body != pu.body
                     && !pj.unbounded
-                    && !(pu.immovable && pj.immovable)
+                    && !both_static(pu, pj)
                     && halfspace_overlaps(pu, &pj.aabb, self.margin)
             };
             if pu.awake {
@@ -568,7 +579,7 @@ impl BroadPhase {
             for &v in &self.unbounded[k + 1..] {
                 if let Some(pv) = &self.proxies[v as usize]
                     && (pu.awake || pv.awake)
-                    && !(pu.immovable && pv.immovable)
+                    && !both_static(pu, pv)
                     && pu.body != pv.body
                 {
                     self.pairs
