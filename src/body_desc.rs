@@ -375,9 +375,8 @@ impl BodyDesc {
         check_material(&self.material).map_err(|(field, message)| err(field, message))?;
         non_negative("linear_damping", self.linear_damping)?;
         non_negative("angular_damping", self.angular_damping)?;
-        if let Some(t) = self.force_event_threshold {
-            non_negative("force_event_threshold", t)?;
-        }
+        check_force_threshold(self.force_event_threshold)
+            .map_err(|(field, message)| err(field, message))?;
         if !self.fixed {
             check_mass(self.mass).map_err(|(field, message)| err(field, message))?;
         }
@@ -402,6 +401,17 @@ impl BodyDesc {
             }
         }
         Ok(())
+    }
+}
+
+/// Checks a contact force event threshold: none, or finite and ≥ 0 (N).
+pub(crate) fn check_force_threshold(t: Option<f32>) -> Result<(), (&'static str, String)> {
+    match t {
+        Some(t) if !(t.is_finite() && t >= 0.0) => Err((
+            "force_event_threshold",
+            format!("must be finite and >= 0, got {t}"),
+        )),
+        _ => Ok(()),
     }
 }
 

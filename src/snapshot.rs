@@ -333,12 +333,10 @@ mod file {
                         m.restitution
                     )));
                 }
-                if let Some(t) = record.force_event_threshold
-                    && !(t.is_finite() && t >= 0.0)
+                if let Err((field, message)) =
+                    crate::body_desc::check_force_threshold(record.force_event_threshold)
                 {
-                    return Err(invalid(format!(
-                        "collider {i}: force_event_threshold: must be finite and >= 0, got {t}"
-                    )));
+                    return Err(invalid(format!("collider {i}: {field}: {message}")));
                 }
                 let pose = record.local_pose;
                 let reach = pose.translation.abs().max_element();

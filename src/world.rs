@@ -5,8 +5,8 @@
 //! touches.
 
 use crate::body_desc::{
-    BodyDesc, BodyError, DEFAULT_DENSITY, MAX_GRAVITY, MassSpec, check_material, shape_error,
-    shape_mass, unit_rotation,
+    BodyDesc, BodyError, DEFAULT_DENSITY, MAX_GRAVITY, MassSpec, check_force_threshold,
+    check_material, shape_error, shape_mass, unit_rotation,
 };
 use crate::profile::StepProfile;
 use crate::settings::{ResolverChoice, WorldSettings};
@@ -528,7 +528,6 @@ impl World {
     pub fn set_sensor(&mut self, handle: ColliderHandle, sensor: bool) -> Result<(), StepError> {
         let body = self.change_collider(handle, |c| c.sensor = sensor)?;
         self.wake_around(body);
-        self.stamp += 1;
         Ok(())
     }
 
@@ -560,7 +559,6 @@ impl World {
     ///     .add_body(BodyDesc::dynamic("ghost", ShapeDesc::Ball { radius: 0.5 }).at(Vec3::new(0.0, 0.5, 0.0)))
     ///     .unwrap();
     /// // The ghost's collider makes no contact with anything.
-    /// let ghost_collider = world.colliders_of(ghost)[0];
     /// world.set_pair_filter(Some(Box::new(move |a: &jostle::Collider, b: &jostle::Collider| {
     ///     a.body != ghost && b.body != ghost
     /// })));
@@ -568,7 +566,6 @@ impl World {
     ///     world.step(1.0 / 60.0).unwrap();
     /// }
     /// assert!(world.body(ghost).unwrap().position.y < -1.0, "it fell through the ground");
-    /// # let _ = ghost_collider;
     /// ```
     pub fn set_pair_filter(&mut self, filter: Option<Box<PairFilter>>) {
         self.pair_filter = filter;
@@ -583,14 +580,7 @@ impl World {
         handle: ColliderHandle,
         threshold: Option<f32>,
     ) -> Result<(), StepError> {
-        if let Some(t) = threshold
-            && !(t.is_finite() && t >= 0.0)
-        {
-            return Err(invalid((
-                "force_event_threshold",
-                format!("must be finite and >= 0, got {t}"),
-            )));
-        }
+        check_force_threshold(threshold).map_err(invalid)?;
         self.change_collider(handle, |c| c.force_event_threshold = threshold)?;
         Ok(())
     }

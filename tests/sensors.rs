@@ -525,3 +525,28 @@ fn a_fixed_sensor_sees_a_kinematic_body_pass() {
     assert!((53..=55).contains(&seen[0].0), "{seen:?}");
     assert!((188..=190).contains(&seen[1].0), "{seen:?}");
 }
+
+/// A force event threshold is none, or finite and ≥ 0: the API and scene files refuse others,
+/// naming the field.
+#[test]
+fn bad_force_thresholds_are_refused() {
+    use jostle::StepError;
+    let mut w = world(ResolverChoice::default());
+    let ball = w
+        .add_body(BodyDesc::dynamic("ball", ShapeDesc::Ball { radius: 0.5 }))
+        .unwrap();
+    let c = w.colliders_of(ball)[0];
+    for bad in [f32::NAN, -1.0, f32::INFINITY] {
+        match w.set_force_event_threshold(c, Some(bad)) {
+            Err(StepError::Invalid { field, .. }) => assert_eq!(field, "force_event_threshold"),
+            other => panic!("{bad}: {other:?}"),
+        }
+    }
+    assert!(w.set_force_event_threshold(c, Some(0.0)).is_ok());
+    let text =
+        "Scene(bodies: [Body(name: \"b\", shape: Ball(radius: 0.5), force_event_threshold: -2.0)])";
+    let e = jostle::scene::Scene::parse(text, "b.ron")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("force_event_threshold"), "{e}");
+}

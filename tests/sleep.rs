@@ -180,7 +180,8 @@ fn can_sleep_false_is_honoured_with(resolver: &ResolverChoice) {
     run(&mut w, DT, 8.0, |w| assert!(w.body(h).unwrap().sleep.awake));
 }
 
-/// Forty balls of radius 0.5 m started within 1 cm of one point, without gravity: both
+/// Forty balls (radius 0.05, 0.5 and 5 m) started within 2% of their radius of one point,
+/// without gravity: both
 /// resolvers push them apart without giving them velocity (no kinetic energy at any step),
 /// and none falls asleep while still overlapping: a body the resolver moves out of overlap
 /// is moving, whatever its velocity, so what overlap is left is at most what the resolver
@@ -189,58 +190,66 @@ fn can_sleep_false_is_honoured_with(resolver: &ResolverChoice) {
 #[test]
 fn bodies_pushed_apart_without_velocity_do_not_sleep_overlapping() {
     for r in resolvers() {
-        let name = r.name();
-        let mut w = jostle::World::new(jostle::WorldSettings {
-            gravity: Vec3::ZERO,
-            resolver: r.clone(),
-            ..Default::default()
-        });
-        let mut seed = 5u32;
-        let mut jitter = || {
-            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (seed >> 8) as f32 / (1u32 << 24) as f32 * 0.02 - 0.01
-        };
-        let balls: Vec<_> = (0..40)
-            .map(|i| {
-                let at = Vec3::new(jitter(), jitter(), jitter());
-                w.add_body(
-                    BodyDesc::dynamic(format!("b{i}"), ShapeDesc::Ball { radius: 0.5 }).at(at),
-                )
-                .unwrap()
-            })
-            .collect();
-        let mut asleep_at = None;
-        for step in 1..=900 {
-            w.step(DT).unwrap();
-            assert!(
-                w.kinetic_energy() < 1e-6,
-                "{name}: step {step}: the push-out became motion ({} J)",
-                w.kinetic_energy()
-            );
-            if w.bodies().all(|(_, _, b)| !b.is_awake()) {
-                asleep_at = Some(step);
-                break;
-            }
+        for radius in [0.05, 0.5, 5.0] {
+            pushed_apart_with(&r, radius);
         }
-        assert!(
-            asleep_at.is_some(),
-            "{name}: the balls came to rest and slept"
-        );
-        let centres: Vec<Vec3> = balls.iter().map(|&h| w.body(h).unwrap().position).collect();
-        let deepest = centres
-            .iter()
-            .enumerate()
-            .flat_map(|(i, a)| centres[i + 1..].iter().map(move |b| 1.0 - a.distance(*b)))
-            .fold(f32::MIN, f32::max);
-        // What each resolver leaves alone by design: the soft step's push-out slop, the
-        // Millington position pass's epsilon.
-        let tolerance = match &r {
-            ResolverChoice::SoftStep(s) => s.push_out_slop,
-            ResolverChoice::Millington(m) => m.position_epsilon,
-        };
-        assert!(
-            deepest <= tolerance,
-            "{name}: asleep at step {asleep_at:?} with {deepest} m of overlap left (tolerance {tolerance} m)"
-        );
     }
+}
+
+fn pushed_apart_with(r: &ResolverChoice, radius: f32) {
+    let name = format!("{} r = {radius}", r.name());
+    let mut w = jostle::World::new(jostle::WorldSettings {
+        gravity: Vec3::ZERO,
+        resolver: r.clone(),
+        ..Default::default()
+    });
+    let mut seed = 5u32;
+    let mut jitter = || {
+        seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        ((seed >> 8) as f32 / (1u32 << 24) as f32 * 0.04 - 0.02) * radius
+    };
+    let balls: Vec<_> = (0..40)
+        .map(|i| {
+            let at = Vec3::new(jitter(), jitter(), jitter());
+            w.add_body(BodyDesc::dynamic(format!("b{i}"), ShapeDesc::Ball { radius }).at(at))
+                .unwrap()
+        })
+        .collect();
+    let mut asleep_at = None;
+    for step in 1..=1800 {
+        w.step(DT).unwrap();
+        assert!(
+            w.kinetic_energy() < 1e-6,
+            "{name}: step {step}: the push-out became motion ({} J)",
+            w.kinetic_energy()
+        );
+        if w.bodies().all(|(_, _, b)| !b.is_awake()) {
+            asleep_at = Some(step);
+            break;
+        }
+    }
+    assert!(
+        asleep_at.is_some(),
+        "{name}: the balls came to rest and slept"
+    );
+    let centres: Vec<Vec3> = balls.iter().map(|&h| w.body(h).unwrap().position).collect();
+    let deepest = centres
+        .iter()
+        .enumerate()
+        .flat_map(|(i, a)| {
+            centres[i + 1..]
+                .iter()
+                .map(move |b| 2.0 * radius - a.distance(*b))
+        })
+        .fold(f32::MIN, f32::max);
+    // What each resolver leaves alone by design: the soft step's push-out slop, the
+    // Millington position pass's epsilon.
+    let tolerance = match r {
+        ResolverChoice::SoftStep(s) => s.push_out_slop,
+        ResolverChoice::Millington(m) => m.position_epsilon,
+    };
+    assert!(
+        deepest <= tolerance,
+        "{name}: asleep at step {asleep_at:?} with {deepest} m of overlap left (tolerance {tolerance} m)"
+    );
 }

@@ -260,6 +260,10 @@ pub struct NarrowPhase {
     /// The contact force events of the last step ([`NarrowPhase::find_force_events`]).
     #[cfg_attr(feature = "serde", serde(skip))]
     force_events: Vec<ContactForceEvent>,
+    /// Whether a collider of the last update's contact pairs has a force event threshold:
+    /// otherwise [`NarrowPhase::find_force_events`] has nothing to look at.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    any_threshold: bool,
 }
 
 impl std::fmt::Debug for NarrowPhase {
@@ -441,6 +445,9 @@ impl NarrowPhase {
     /// an event for each collider pair with a threshold whose contacts pushed harder.
     pub fn find_force_events(&mut self, colliders: &ColliderSet, dt: f32) {
         self.force_events.clear();
+        if !self.any_threshold {
+            return;
+        }
         let mut start = 0;
         while start < self.contacts.len() {
             let pair_index = self.slots[start].pair;
@@ -645,6 +652,7 @@ impl NarrowPhase {
         touching.clear();
         let mut overlaps = std::mem::take(&mut self.overlaps_scratch);
         overlaps.clear();
+        self.any_threshold = false;
 
         let mut old_pairs = std::mem::replace(&mut self.pairs, std::mem::take(&mut self.spare));
         self.pairs.clear();
@@ -703,6 +711,8 @@ impl NarrowPhase {
                 compute(&mut state, c1, c2, &pos12, settings.prediction);
             }
 
+            self.any_threshold |=
+                c1.force_event_threshold.is_some() || c2.force_event_threshold.is_some();
             // A is the dynamic body when the other is fixed or kinematic; else collider 1's body.
             let flip = b1.is_immovable() && !b2.is_immovable();
             let (a, b) = if flip {
