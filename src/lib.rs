@@ -24,10 +24,8 @@
 //! ```
 #![deny(missing_docs)]
 
-pub mod bench;
 pub mod body_desc;
 pub mod profile;
-pub mod run;
 #[cfg(feature = "scene")]
 pub mod scene;
 pub mod settings;

@@ -3,7 +3,8 @@
 use std::time::Duration;
 
 /// What the last [`crate::World::step`] did and how long each stage took. Built fresh by every
-/// step; read it with [`crate::World::profile`].
+/// step; read it with [`crate::World::profile`]. The times are wall-clock times, zero where the
+/// platform has no clock (`wasm32-unknown-unknown`, [`jostle_resolve::clock`]).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StepProfile {
     /// Whole step.

@@ -110,6 +110,17 @@ mod file {
     }
 
     impl Snapshot {
+        /// The world settings the snapshot carries.
+        pub fn settings(&self) -> &WorldSettings {
+            &self.settings
+        }
+
+        /// The world settings, to change before [`World::from_snapshot`] (which validates
+        /// them as strictly as a scene file's): for example another resolver, or sleeping off.
+        pub fn settings_mut(&mut self) -> &mut WorldSettings {
+            &mut self.settings
+        }
+
         /// The snapshot as RON text, as [`Snapshot::save`] writes it.
         pub fn to_ron(&self) -> Result<String, ron::Error> {
             ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default().struct_names(true))

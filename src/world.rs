@@ -20,7 +20,7 @@ use jostle_collide::{
 use jostle_math::{Quat, Vec3};
 use jostle_resolve::{Resolver, StepContext};
 use jostle_sleep::IslandSet;
-use std::time::Instant;
+use jostle_resolve::clock::Stopwatch;
 use thiserror::Error;
 
 /// Why a step or an API call was refused.
@@ -1126,7 +1126,7 @@ impl World {
         if !(dt.is_finite() && dt > 0.0 && dt <= crate::MAX_DT) {
             return Err(StepError::InvalidDt(dt));
         }
-        let start = Instant::now();
+        let start = Stopwatch::start();
         let mut p = StepProfile::default();
         let mut report = StepReport::default();
         if self.paths {
@@ -1138,7 +1138,7 @@ impl World {
 
         self.detect(&mut p);
 
-        let t = Instant::now();
+        let t = Stopwatch::start();
         let woke = stages::wake_touching(
             &mut self.bodies,
             &mut self.islands,
@@ -1154,7 +1154,7 @@ impl World {
             self.narrow.restore_events(events);
         }
 
-        let t = Instant::now();
+        let t = Stopwatch::start();
         stages::gather(
             &mut self.bodies,
             self.narrow.contacts(),
@@ -1165,7 +1165,7 @@ impl World {
         );
         p.gather = t.elapsed();
 
-        let t = Instant::now();
+        let t = Stopwatch::start();
         let ctx = StepContext {
             gravity: self.settings.gravity,
             dt,
@@ -1175,7 +1175,7 @@ impl World {
                 .step(&mut self.scratch.bodies, &mut self.scratch.contacts, &ctx);
         p.resolve = t.elapsed();
 
-        let t = Instant::now();
+        let t = Stopwatch::start();
         stages::ccd(
             &self.bodies,
             &self.colliders,
@@ -1187,7 +1187,7 @@ impl World {
         );
         p.ccd = t.elapsed();
 
-        let t = Instant::now();
+        let t = Stopwatch::start();
         stages::scatter(
             &mut self.bodies,
             &mut self.narrow,
@@ -1198,7 +1198,7 @@ impl World {
         self.narrow.find_force_events(&self.colliders, dt);
         p.scatter = t.elapsed();
 
-        let t = Instant::now();
+        let t = Stopwatch::start();
         stages::sleep(
             &mut self.bodies,
             &mut self.islands,
@@ -1221,7 +1221,7 @@ impl World {
 
     /// Broad and narrow phase, accumulated into the profile.
     fn detect(&mut self, p: &mut StepProfile) {
-        let t = Instant::now();
+        let t = Stopwatch::start();
         let pairs = self.broad.update(
             &self.colliders,
             &self.bodies,
@@ -1229,7 +1229,7 @@ impl World {
         );
         p.broad_phase += t.elapsed();
         p.candidate_pairs = pairs.len();
-        let t = Instant::now();
+        let t = Stopwatch::start();
         let stats = self.narrow.update_filtered(
             pairs,
             &self.colliders,

@@ -7,7 +7,7 @@
 //! with the resolver named by `FAMILY_RESOLVER` (`millington`, `soft-step`, or `rigid` for
 //! the soft step with [`SoftStepSettings::rigid_contacts`]): `cargo test
 //! --release --test stability_family -- --ignored --nocapture family_table`; the same scenes
-//! run side by side with rapier3d in `cargo bench --bench stability_family`. The Millington
+//! run side by side with rapier3d in `cargo bench -p jostle-compare --bench stability_family`. The Millington
 //! resolver meets the criterion on none of the family (a 10-box column falls); the cases below
 //! run the engine's default, the soft step at its defaults: those that meet the criterion are
 //! tests of their own, the others are listed with their figures in benches/RESULTS.md ("Load

@@ -1,4 +1,5 @@
-//! Helpers shared by the facade's criterion benches (`mod common;` in each): loading the
+//! Helpers shared by the criterion benches of the facade (`mod common;` in each) and of
+//! `jostle-compare` (included by path): finding the workspace, loading the
 //! benchmark scenes of `assets/`, settling a world, a short criterion configuration, and
 //! reading criterion's median back for the tables the benches print after their groups.
 //!
@@ -8,7 +9,7 @@
 use criterion::Criterion;
 use jostle::World;
 use jostle::scene::Scene;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 /// The time step of every facade bench (s).
@@ -27,10 +28,18 @@ pub const SCENES: [&str; 9] = [
     "piles_4000",
 ];
 
+/// The workspace's root directory: the nearest ancestor of the bench's crate that holds
+/// `assets/` (the facade's crate is the root; `jostle-compare` sits two levels below it).
+pub fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .find(|dir| dir.join("assets").is_dir())
+        .expect("the workspace's assets/ directory")
+}
+
 /// Loads `assets/<name>.ron`.
 pub fn scene(name: &str) -> Scene {
-    let path = format!("{}/assets/{name}.ron", env!("CARGO_MANIFEST_DIR"));
-    Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+    Scene::load(root().join(format!("assets/{name}.ron"))).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// The scene with its own settings (resolver, sleep), stepped `steps` times at [`DT`].
@@ -72,7 +81,7 @@ fn criterion_home() -> PathBuf {
         .or_else(|| {
             std::env::var_os("CARGO_TARGET_DIR").map(|d| PathBuf::from(d).join("criterion"))
         })
-        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/target/criterion")))
+        .unwrap_or_else(|| root().join("target/criterion"))
 }
 
 /// Criterion's median for `group/id` (ns), read back from its report directory, if present.

@@ -59,7 +59,7 @@ pub enum SceneError {
 impl SceneError {
     /// The error as found in the file `name` whose text is `text`: the file named, and the
     /// line and column of the field (or body) when the text shows where it is.
-    pub(crate) fn in_file(self, name: &str, text: &str) -> Self {
+    pub fn in_file(self, name: &str, text: &str) -> Self {
         match self {
             Self::Body {
                 error, at, index, ..

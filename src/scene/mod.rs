@@ -24,16 +24,18 @@
 //! ([`Perturb`]) shifts and turns them a little from a seed, so a file gives a reproducible
 //! perturbed start. An optional `camera`
 //! ([`Camera`]) fixes the view of renderers; without one they frame the scene themselves. An
-//! optional `analytic` ([`crate::bench::Analytic`]) declares the scene's closed form, which
+//! optional `analytic` ([`Analytic`]) declares the scene's closed form, which
 //! `jostle bench` compares the run against.
 //!
 //! Errors never panic and lose nothing: a malformed file names the file, line and column (and
 //! the body around that position when there is one); a bad value names the body and the field.
 
+mod analytic;
 mod error;
 mod generators;
 mod perturb;
 
+pub use analytic::Analytic;
 pub use error::SceneError;
 pub use generators::Generator;
 pub use perturb::Perturb;
@@ -105,9 +107,9 @@ pub struct Scene {
     #[serde(default)]
     pub camera: Option<Camera>,
     /// The closed form `jostle bench` compares the run against, for its analytic error
-    /// ([`crate::bench::Analytic`], e.g. `analytic: FreeFall(body: "ball")`). Default: none.
+    /// ([`Analytic`], e.g. `analytic: FreeFall(body: "ball")`). Default: none.
     #[serde(default)]
-    pub analytic: Option<crate::bench::Analytic>,
+    pub analytic: Option<Analytic>,
 }
 
 fn default_camera_position() -> Vec3 {

@@ -1,7 +1,7 @@
 //! The stability family of issue 15, as scene files: columns, planar and 3D pyramids, a
 //! running-bond wall, and heavy boxes on light ones, each at any box size, friction and seeded
 //! perturbation of the start. Shared by `tests/stability_family.rs` and the side-by-side bench
-//! `benches/stability_family.rs` (included there by path), so both run the same scenes.
+//! `crates/jostle-compare/benches/stability_family.rs` (included there by path), so both run the same scenes.
 //!
 //! Every case runs with sleeping off (so standing still is the resolver's doing), with the
 //! scene's settings or the resolver a caller names, and reports what the criterion needs: the largest lateral drift of any

@@ -2,7 +2,7 @@
 //! table of cost against error, and writes `results.csv` and one frontier plot per scene
 //! (error against ms per 1/60 s step, one curve per resolver) as SVG and PNG.
 //!
-//! The measuring is `jostle::bench::run_case`; this file only loops, prints and draws. Plots are
+//! The measuring is `harness::bench::run_case`; this file only loops, prints and draws. Plots are
 //! drawn with plotters; text uses the DejaVu Sans bytes of the `dejavu` crate through plotters'
 //! ab_glyph renderer, so it works headless with no system fonts.
 
@@ -10,8 +10,9 @@ use crate::staged::Staged;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use jostle::ResolverChoice;
-use jostle::bench::{Analytic, Metrics, Setting, Sweep, run_case};
-use jostle::run::{Overrides, load};
+use crate::harness::bench::{Metrics, Setting, Sweep, run_case};
+use crate::harness::run::{Overrides, load};
+use jostle::scene::Analytic;
 use jostle::scene::Scene;
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -2,10 +2,11 @@
 //! one JSON object, can write a per-step CSV trace, and can render the run to a PNG or GIF;
 //! `jostle bench` sweeps resolvers and settings over scenes and writes cost against error.
 //!
-//! It is a thin shell over the facade: scene loading, the run loop and the trace format live
-//! in `jostle` itself (`jostle::scene`, `jostle::run`), so tests and benches use the same code.
+//! Scene files and snapshots are the engine's (`jostle::scene`, `jostle::snapshot`); the run
+//! loop, the trace format and the benchmark measurements are this crate's [`harness`].
 
 mod bench_cmd;
+mod harness;
 mod render_out;
 mod run_cmd;
 mod staged;

@@ -6,7 +6,7 @@ use crate::staged::Staged;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use jostle::ResolverChoice;
-use jostle::run::{
+use crate::harness::run::{
     Overrides, RunSetup, RunSummary, TRACE_HEADER, load, run as run_world, write_trace_rows,
 };
 use std::fs::File;

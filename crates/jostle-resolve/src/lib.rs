@@ -11,6 +11,7 @@
 //! resolver, with no special case.
 #![deny(missing_docs)]
 
+pub mod clock;
 pub mod contact;
 mod energy;
 pub mod integrate;

@@ -86,7 +86,7 @@ use crate::integrate::{integrate_positions, integrate_velocities};
 use crate::{Contact, ResolveStats, Resolver, SolverBody, StepContext};
 use islands::Islands;
 use passes::{PositionPass, VelocityPass};
-use std::time::Instant;
+use crate::clock::Stopwatch;
 pub use worst_first::PickWork;
 use worst_first::{PickScratch, run_islands};
 
@@ -157,7 +157,7 @@ impl MillingtonResolver {
         let mut stats = ResolveStats::default();
         let settings = &self.settings;
 
-        let start = Instant::now();
+        let start = Stopwatch::start();
         self.prepared.clear();
         self.prepared.extend(contacts.iter().map(|c| {
             prepare(c, bodies, dt, settings.velocity_limit)
@@ -168,7 +168,7 @@ impl MillingtonResolver {
         stats.islands = self.islands.len() as u32;
         stats.prepare_time = start.elapsed();
 
-        let start = Instant::now();
+        let start = Stopwatch::start();
         self.spins.clear();
         self.spins.extend(bodies.iter().map(|b| b.angular_velocity));
         let mut pass = PositionPass {
@@ -187,7 +187,7 @@ impl MillingtonResolver {
         self.work[0] = std::mem::take(&mut self.scratch.work);
         stats.position_time = start.elapsed();
 
-        let start = Instant::now();
+        let start = Stopwatch::start();
         // Projection turns a rotated body's spin with it (position.rs, `apply_moves`), so the
         // closing velocities prepared before the position pass are refreshed by the change of
         // spin of their bodies; without this the velocity pass resolved stale velocities and a
@@ -274,11 +274,11 @@ impl Resolver for MillingtonResolver {
         contacts: &mut [Contact],
         ctx: &StepContext,
     ) -> ResolveStats {
-        let start = Instant::now();
+        let start = Stopwatch::start();
         integrate_velocities(bodies, ctx.gravity, ctx.dt);
         let velocities_time = start.elapsed();
         let mut stats = self.resolve_contacts(bodies, contacts, ctx.dt);
-        let start = Instant::now();
+        let start = Stopwatch::start();
         integrate_positions(bodies, ctx.dt);
         stats.integrate_time = velocities_time + start.elapsed();
         stats.threads = 1;

@@ -138,7 +138,8 @@ use batch::{ManifoldLanes, PointLanes};
 use jostle_math::{Mat3, Vec3};
 use shared::{Shared, share, share_one, slice_mut};
 use std::cell::Cell;
-use std::time::{Duration, Instant};
+use crate::clock::Stopwatch;
+use std::time::Duration;
 use team::{Crew, Plan, Solo, Team};
 
 /// The soft-step resolver (see the module docs). Holds its settings and scratch buffers
@@ -535,7 +536,7 @@ impl Timing {
 
     /// Runs `f`, adding its wall time to `kind`.
     fn time(&self, kind: usize, f: impl FnOnce()) {
-        let t = Instant::now();
+        let t = Stopwatch::start();
         f();
         let cell = &self.0[kind];
         cell.set(cell.get() + t.elapsed());
@@ -786,7 +787,7 @@ impl Resolver for SoftStepResolver {
         let h = ctx.dt / substeps as f32;
         let inv_h = if h > 0.0 { 1.0 / h } else { 0.0 };
 
-        let start = Instant::now();
+        let start = Stopwatch::start();
         self.load_bodies(bodies);
         let any_restitution = self.prepare_contacts(bodies, contacts, h, ctx.gravity.length());
         self.mark_contact_rows(bodies, contacts);
@@ -844,7 +845,7 @@ impl Resolver for SoftStepResolver {
         } else {
             1
         };
-        let substeps_start = Instant::now();
+        let substeps_start = Stopwatch::start();
         let direct_live = !self.direct.is_empty();
         if threads > 1 {
             owner_bounds(
@@ -926,7 +927,7 @@ impl Resolver for SoftStepResolver {
         }
         let [integrate_time, solve_time, mut relax_time] = times;
         stats.threads = threads as u32;
-        let t = Instant::now();
+        let t = Stopwatch::start();
         let threshold = self.settings.restitution_threshold;
         if any_restitution && solve::any_bounces(&self.batches, threshold) {
             // The bounce is an impulse of this step only: what the next step warm starts
@@ -979,7 +980,7 @@ impl Resolver for SoftStepResolver {
         }
         relax_time += t.elapsed();
 
-        let t = Instant::now();
+        let t = Stopwatch::start();
         for c in contacts.iter_mut() {
             c.impulse = jostle_math::Vec3::ZERO;
         }

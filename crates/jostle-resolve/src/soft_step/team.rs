@@ -294,9 +294,13 @@ where
 
 /// Threads a step's team uses: [`set_threads`]' number if one was set, else the environment
 /// variable `JOSTLE_THREADS` if it holds a positive number, else the CPU's available
-/// parallelism; 1 without the `parallel` feature; at most [`MAX_THREADS`].
+/// parallelism; 1 without the `parallel` feature or on `wasm32-unknown-unknown` (which
+/// cannot start threads); at most [`MAX_THREADS`].
 pub fn available_threads() -> usize {
-    if cfg!(not(feature = "parallel")) {
+    if cfg!(any(
+        not(feature = "parallel"),
+        all(target_family = "wasm", target_os = "unknown")
+    )) {
         return 1;
     }
     static DEFAULT: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
@@ -500,7 +504,7 @@ fn helper(board: &Board, index: usize) {
 /// [`POLL_MICROS`], then parks until [`Helpers::run`] unparks it.
 fn next_job(board: &Board, index: usize, seen: u64, poll: bool) -> u64 {
     let open = |epoch: u64| !epoch.is_multiple_of(2) && epoch != seen;
-    let mut started = std::time::Instant::now();
+    let mut started = crate::clock::Stopwatch::start();
     let mut poll_micros = if poll { u128::from(POLL_MICROS) } else { 0 };
     let mut spins = 0u32;
     loop {
@@ -524,7 +528,7 @@ fn next_job(board: &Board, index: usize, seen: u64, poll: bool) -> u64 {
         while board.parked[index].load(Ordering::SeqCst) {
             std::thread::park();
         }
-        started = std::time::Instant::now();
+        started = crate::clock::Stopwatch::start();
         poll_micros = u128::from(POLL_MICROS);
     }
 }

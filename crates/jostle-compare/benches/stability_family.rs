@@ -10,13 +10,13 @@
 //! penetration after 2 s, the bodies that moved more than half a box sideways, and the median
 //! ms per step, for both engines.
 //!
-//! Run: `cargo bench --bench stability_family` (several minutes; `FAMILY=base` runs only the
+//! Run: `cargo bench -p jostle-compare --bench stability_family` (several minutes; `FAMILY=base` runs only the
 //! base family, `FAMILY=variations` only the variations, `FAMILY=heavy` the sweep of heavy
 //! boxes on light ones (`family::heavy_sweep`); `FAMILY_ONLY` keeps the cases whose
 //! name contains one of its `|`-separated parts, as in `family_table`). With `--test` (`cargo
-//! test --benches`) only a short smoke run is made.
+//! test -p jostle-compare --benches`) only a short smoke run is made.
 
-#[path = "../tests/common/family.rs"]
+#[path = "../../../tests/common/family.rs"]
 mod family;
 
 use family::{Case, Subject};

@@ -1,7 +1,7 @@
 //! Running a scene headless: the loop the `jostle` command, the tests and the benchmarks share,
 //! with a per-step observer, the CSV trace and the summary of a run.
 
-use crate::world::{StepError, World};
+use jostle::{StepError, World};
 use std::io::Write;
 use std::time::Duration;
 
@@ -114,7 +114,7 @@ pub fn run(
     // Reserved for at most 65,536 steps: reserving `steps` up front made `--steps 4000000000`
     // abort on a 64 GB allocation before the first step. Longer runs grow as they go.
     let reserve = steps.min(1 << 16) as usize;
-    let mut stage_times: Vec<Vec<Duration>> = (0..crate::StepProfile::STAGES)
+    let mut stage_times: Vec<Vec<Duration>> = (0..jostle::StepProfile::STAGES)
         .map(|_| Vec::with_capacity(reserve))
         .collect();
     let dynamic = world.bodies().filter(|(_, _, b)| !b.is_fixed()).count();
@@ -171,8 +171,7 @@ pub struct RunSetup {
     /// The scene's `steps` (for a snapshot: 600, the scene default).
     pub steps: u64,
     /// The scene's camera, if it sets one (snapshots carry none).
-    #[cfg(feature = "scene")]
-    pub camera: Option<crate::scene::Camera>,
+    pub camera: Option<jostle::scene::Camera>,
 }
 
 /// Overrides a command line applies on top of a scene's or snapshot's settings.
@@ -180,7 +179,7 @@ pub struct RunSetup {
 pub struct Overrides {
     /// Another resolver. A scene or snapshot that already names the same resolver keeps its
     /// own settings for it ([`Overrides::apply_resolver`]).
-    pub resolver: Option<crate::ResolverChoice>,
+    pub resolver: Option<jostle::ResolverChoice>,
     /// Sleeping on or off.
     pub sleep: Option<bool>,
 }
@@ -190,7 +189,7 @@ impl Overrides {
     /// different resolver replaces it (with the override's settings), the same one leaves
     /// `own` and its settings as they are. `--resolver millington` on a scene that declares
     /// `Millington(velocity_iterations: 64)` runs those 64 iterations.
-    pub fn apply_resolver(&self, own: &mut crate::ResolverChoice) {
+    pub fn apply_resolver(&self, own: &mut jostle::ResolverChoice) {
         if let Some(r) = &self.resolver
             && r.name() != own.name()
         {
@@ -201,23 +200,22 @@ impl Overrides {
 
 /// Loads a scene file, or a snapshot written by `jostle run --snapshot` (recognised by its
 /// first item, `Snapshot(`), applies the overrides and builds the world.
-#[cfg(feature = "scene")]
 pub fn load(path: &std::path::Path, overrides: &Overrides) -> Result<RunSetup, LoadError> {
-    use crate::scene::Scene;
-    use crate::snapshot::Snapshot;
+    use jostle::scene::Scene;
+    use jostle::snapshot::Snapshot;
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path)
         .map_err(|e| LoadError::Io(format!("{file}: cannot read: {e}")))?;
     if Snapshot::is_snapshot_text(&text) {
         let mut snapshot = Snapshot::parse(&text, &file)?;
-        overrides.apply_resolver(&mut snapshot.settings.resolver);
+        overrides.apply_resolver(&mut snapshot.settings_mut().resolver);
         if let Some(on) = overrides.sleep {
-            snapshot.settings.sleep.enabled = on;
+            snapshot.settings_mut().sleep.enabled = on;
         }
         let (name, dt) = (snapshot.scene.clone(), snapshot.dt);
         let world = World::from_snapshot(snapshot).map_err(|e| match e {
-            crate::snapshot::SnapshotError::Invalid { message, .. } => {
-                crate::snapshot::SnapshotError::Invalid {
+            jostle::snapshot::SnapshotError::Invalid { message, .. } => {
+                jostle::snapshot::SnapshotError::Invalid {
                     file: file.clone(),
                     message,
                 }
@@ -251,7 +249,6 @@ pub fn load(path: &std::path::Path, overrides: &Overrides) -> Result<RunSetup, L
 }
 
 /// Why a scene or snapshot could not be loaded.
-#[cfg(feature = "scene")]
 #[derive(Clone, Debug, thiserror::Error, PartialEq)]
 pub enum LoadError {
     /// The file could not be read.
@@ -259,23 +256,22 @@ pub enum LoadError {
     Io(String),
     /// A bad scene (boxed: a scene error carries the file, the place and the message).
     #[error(transparent)]
-    Scene(Box<crate::scene::SceneError>),
+    Scene(Box<jostle::scene::SceneError>),
     /// A bad snapshot.
     #[error(transparent)]
-    Snapshot(#[from] crate::snapshot::SnapshotError),
+    Snapshot(#[from] jostle::snapshot::SnapshotError),
 }
 
-#[cfg(feature = "scene")]
-impl From<crate::scene::SceneError> for LoadError {
-    fn from(e: crate::scene::SceneError) -> Self {
+impl From<jostle::scene::SceneError> for LoadError {
+    fn from(e: jostle::scene::SceneError) -> Self {
         Self::Scene(Box::new(e))
     }
 }
 
-#[cfg(all(test, feature = "scene"))]
+#[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{MillingtonSettings, ResolverChoice, SoftStepSettings};
+    use jostle::{MillingtonSettings, ResolverChoice, SoftStepSettings};
 
     fn resolver_after(scene: &str, name: &str) -> ResolverChoice {
         let path = std::env::temp_dir().join(format!(
@@ -295,7 +291,7 @@ mod tests {
     #[test]
     fn naming_the_scenes_own_resolver_keeps_its_settings() {
         let scene = "Scene(resolver: Millington(velocity_iterations: 64, relaxation: 0.5))";
-        let Some(own) = crate::scene::Scene::parse(scene, "t.ron").unwrap().resolver else {
+        let Some(own) = jostle::scene::Scene::parse(scene, "t.ron").unwrap().resolver else {
             panic!("the scene names a resolver")
         };
         assert_eq!(resolver_after(scene, "millington"), own);

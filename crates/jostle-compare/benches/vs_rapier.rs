@@ -20,15 +20,16 @@
 //!
 //! After criterion, one markdown table per scene is printed to stderr: engine, criterion's
 //! median ms/step, the drift run's median ms/step, drift (m) and the ratios jostle / rapier3d.
-//! Run: `cargo bench --bench vs_rapier` (about 2.5 minutes, most of it the Millington
-//! resolver's 10 s of the 20-row pyramid); `VS_RAPIER_SCENES=wall_20x10,stack_15 cargo bench --bench
-//! vs_rapier` runs only the named scenes (keys: `pyramid20`, `pyramid3d_10`, `wall_20x10`,
+//! Run: `cargo bench -p jostle-compare --bench vs_rapier` (about 2.5 minutes, most of it the Millington
+//! resolver's 10 s of the 20-row pyramid); `VS_RAPIER_SCENES=wall_20x10,stack_15 cargo bench -p
+//! jostle-compare --bench vs_rapier` runs only the named scenes (keys: `pyramid20`, `pyramid3d_10`, `wall_20x10`,
 //! `stack_15`). The ground is a fixed 200 × 1 × 200 m cuboid in rapier3d
 //! (its top face at y = 0) and a half-space in jostle; friction combines as the mean in
 //! rapier3d and both sides use 0.6, so the pair's coefficient is 0.6 in both engines.
 //!
-//! With `--test` (`cargo test --benches`), only a short smoke run is made.
+//! With `--test` (`cargo test -p jostle-compare --benches`), only a short smoke run is made.
 
+#[path = "../../../benches/common/mod.rs"]
 mod common;
 
 use criterion::Criterion;
@@ -196,7 +197,7 @@ impl Jostle {
 }
 
 fn load(asset: &str) -> Scene {
-    Scene::load(format!("{}/assets/{asset}.ron", env!("CARGO_MANIFEST_DIR"))).expect("asset loads")
+    common::scene(asset)
 }
 
 impl Engine for Jostle {
