@@ -18,9 +18,9 @@ use jostle_collide::{
     RayHit, SensorEvent,
 };
 use jostle_math::{Quat, Vec3};
+use jostle_resolve::clock::Stopwatch;
 use jostle_resolve::{Resolver, StepContext};
 use jostle_sleep::IslandSet;
-use jostle_resolve::clock::Stopwatch;
 use thiserror::Error;
 
 /// Why a step or an API call was refused.

@@ -6,12 +6,12 @@
 //! drawn with plotters; text uses the DejaVu Sans bytes of the `dejavu` crate through plotters'
 //! ab_glyph renderer, so it works headless with no system fonts.
 
+use crate::harness::bench::{Metrics, Setting, Sweep, run_case};
+use crate::harness::run::{Overrides, load};
 use crate::staged::Staged;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use jostle::ResolverChoice;
-use crate::harness::bench::{Metrics, Setting, Sweep, run_case};
-use crate::harness::run::{Overrides, load};
 use jostle::scene::Analytic;
 use jostle::scene::Scene;
 use plotters::coord::Shift;

@@ -1,14 +1,14 @@
 //! `jostle run`: step a scene, show progress, print the summary, write the trace, and render
 //! the run to an image or an animation (`--render`, see `render_out`).
 
+use crate::harness::run::{
+    Overrides, RunSetup, RunSummary, TRACE_HEADER, load, run as run_world, write_trace_rows,
+};
 use crate::render_out::{self, RenderFlags};
 use crate::staged::Staged;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use jostle::ResolverChoice;
-use crate::harness::run::{
-    Overrides, RunSetup, RunSummary, TRACE_HEADER, load, run as run_world, write_trace_rows,
-};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};

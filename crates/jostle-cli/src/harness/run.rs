@@ -291,7 +291,10 @@ mod tests {
     #[test]
     fn naming_the_scenes_own_resolver_keeps_its_settings() {
         let scene = "Scene(resolver: Millington(velocity_iterations: 64, relaxation: 0.5))";
-        let Some(own) = jostle::scene::Scene::parse(scene, "t.ron").unwrap().resolver else {
+        let Some(own) = jostle::scene::Scene::parse(scene, "t.ron")
+            .unwrap()
+            .resolver
+        else {
             panic!("the scene names a resolver")
         };
         assert_eq!(resolver_after(scene, "millington"), own);

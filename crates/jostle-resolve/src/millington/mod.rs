@@ -82,11 +82,11 @@ pub use velocity::{
     update_velocity, velocity_change_per_unit_impulse, velocity_key,
 };
 
+use crate::clock::Stopwatch;
 use crate::integrate::{integrate_positions, integrate_velocities};
 use crate::{Contact, ResolveStats, Resolver, SolverBody, StepContext};
 use islands::Islands;
 use passes::{PositionPass, VelocityPass};
-use crate::clock::Stopwatch;
 pub use worst_first::PickWork;
 use worst_first::{PickScratch, run_islands};
 

@@ -133,12 +133,12 @@ pub use prepare::PrepareParams;
 pub use settings::SoftStepSettings;
 pub use softness::Softness;
 
+use crate::clock::Stopwatch;
 use crate::{Contact, ResolveStats, Resolver, STATIC_BODY, SolverBody, StepContext};
 use batch::{ManifoldLanes, PointLanes};
 use jostle_math::{Mat3, Vec3};
 use shared::{Shared, share, share_one, slice_mut};
 use std::cell::Cell;
-use crate::clock::Stopwatch;
 use std::time::Duration;
 use team::{Crew, Plan, Solo, Team};
 
