@@ -1136,7 +1136,7 @@ impl World {
             }
         }
 
-        self.detect(&mut p);
+        self.detect(&mut p, dt);
 
         let t = Stopwatch::start();
         let woke = stages::wake_touching(
@@ -1150,7 +1150,7 @@ impl World {
             // Again with the bodies that woke; the first update's events are kept (the
             // second sees its touching pairs as old ones).
             let events = self.narrow.take_events();
-            self.detect(&mut p);
+            self.detect(&mut p, dt);
             self.narrow.restore_events(events);
         }
 
@@ -1219,23 +1219,33 @@ impl World {
         Ok(report)
     }
 
-    /// Broad and narrow phase, accumulated into the profile.
-    fn detect(&mut self, p: &mut StepProfile) {
+    /// Broad and narrow phase ahead of a step of `dt`, accumulated into the profile; fast
+    /// pairs get speculative contacts as far as they can close within the step
+    /// ([`NarrowPhase::update_swept`]).
+    fn detect(&mut self, p: &mut StepProfile, dt: f32) {
+        // Speculative contacts ahead of fast bodies are part of continuous collision.
+        let dt = if self.settings.collide.ccd.enabled {
+            dt
+        } else {
+            0.0
+        };
         let t = Stopwatch::start();
-        let pairs = self.broad.update(
+        let pairs = self.broad.update_swept(
             &self.colliders,
             &self.bodies,
             self.settings.collide.prediction,
+            dt,
         );
         p.broad_phase += t.elapsed();
         p.candidate_pairs = pairs.len();
         let t = Stopwatch::start();
-        let stats = self.narrow.update_filtered(
+        let stats = self.narrow.update_swept(
             pairs,
             &self.colliders,
             &self.bodies,
             &self.settings.collide,
             self.pair_filter.as_deref(),
+            dt,
         );
         p.narrow_phase += t.elapsed();
         p.manifolds = stats.manifolds;

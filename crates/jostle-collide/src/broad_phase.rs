@@ -65,6 +65,9 @@ struct Proxy {
     /// World pose and shape identity the boxes were computed for.
     pose: Pose,
     shape_id: usize,
+    /// The step's motion the box was swept over ([`BroadPhase::update_swept`]): the body's
+    /// displacement at its velocity, and how far its turn moves a point (m); zero unswept.
+    sweep: (Vec3, f32),
     /// The shape's box at `pose`, enlarged by the margin: what pairs are decided on.
     aabb: Aabb,
     /// The box stored in the tree: contains `aabb`, grown by `slack` when last rewritten.
@@ -78,6 +81,8 @@ pub struct BroadPhase {
     workspace: BvhWorkspace,
     proxies: Vec<Option<Proxy>>,
     margin: f32,
+    /// The step the boxes are swept over ([`BroadPhase::update_swept`]); 0: not swept.
+    dt: f32,
     slack: f32,
     pairs: Vec<ColliderPair>,
     awake_bounded: Vec<u32>,
@@ -138,6 +143,7 @@ impl BroadPhase {
             workspace: BvhWorkspace::default(),
             proxies: Vec::new(),
             margin: f32::NAN,
+            dt: 0.0,
             slack,
             pairs: Vec::new(),
             awake_bounded: Vec::new(),
@@ -210,11 +216,28 @@ impl BroadPhase {
         bodies: &BodySet,
         margin: f32,
     ) -> &[ColliderPair] {
+        self.update_swept(colliders, bodies, margin, 0.0)
+    }
+
+    /// [`BroadPhase::update`] ahead of a step of `dt` seconds: the enlarged box of a collider
+    /// whose body (awake, not fixed, CCD not off) moves more than half the margin within the step at its current velocity
+    /// also covers the box moved by that displacement, grown by how far the body's turn
+    /// moves a point of it ([`Collider::turn_reach`]), so that the pairs a fast body can meet
+    /// within the step are candidates (for the speculative contacts of
+    /// [`crate::NarrowPhase::update_swept`]). `dt` = 0 is [`BroadPhase::update`].
+    pub fn update_swept(
+        &mut self,
+        colliders: &ColliderSet,
+        bodies: &BodySet,
+        margin: f32,
+        dt: f32,
+    ) -> &[ColliderPair] {
         let margin = if margin.is_finite() {
             margin.max(0.0)
         } else {
             0.0
         };
+        self.dt = if dt.is_finite() { dt.max(0.0) } else { 0.0 };
         let margin_changed = margin != self.margin;
         self.margin = margin;
         let tree_changed = self.update_proxies(colliders, bodies, margin_changed);
@@ -293,6 +316,26 @@ impl BroadPhase {
             let shape_id = shape_id(collider);
             let awake = body.is_awake();
             let immovable = body.is_immovable();
+            let unbounded = collider.is_unbounded();
+            let sweep = if self.dt > 0.0
+                && awake
+                && !unbounded
+                && !body.is_fixed()
+                && body.ccd != jostle_body::CcdMode::Off
+            {
+                let shift = body.linear_velocity * self.dt;
+                let turn = collider.turn_reach(body, self.dt);
+                if shift.length() + turn > 0.5 * self.margin
+                    && shift.is_finite()
+                    && turn.is_finite()
+                {
+                    (shift, turn)
+                } else {
+                    (Vec3::ZERO, 0.0)
+                }
+            } else {
+                (Vec3::ZERO, 0.0)
+            };
             let proxy = &mut self.proxies[i as usize];
             let fresh = match proxy {
                 Some(p) => {
@@ -300,15 +343,22 @@ impl BroadPhase {
                         || p.generation != handle.generation()
                         || p.pose != pose
                         || p.shape_id != shape_id
+                        || p.sweep != sweep
                 }
                 None => true,
             };
             if fresh {
-                let unbounded = collider.is_unbounded();
                 let aabb = if unbounded {
                     Aabb::new_invalid()
                 } else {
-                    collider.shape.compute_aabb(&pose).loosened(self.margin)
+                    let at_pose = collider.shape.compute_aabb(&pose).loosened(self.margin);
+                    if sweep == (Vec3::ZERO, 0.0) {
+                        at_pose
+                    } else {
+                        let (shift, turn) = sweep;
+                        let moved = Aabb::new(at_pose.mins + shift, at_pose.maxs + shift);
+                        at_pose.merged(&moved).loosened(turn)
+                    }
                 };
                 let normal = collider
                     .shape
@@ -325,6 +375,7 @@ impl BroadPhase {
                     normal,
                     pose,
                     shape_id,
+                    sweep,
                     aabb,
                     fat,
                 });

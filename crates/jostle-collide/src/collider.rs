@@ -194,6 +194,28 @@ impl Collider {
     pub fn is_unbounded(&self) -> bool {
         self.shape.as_halfspace().is_some()
     }
+
+    /// The farthest any point of the shape lies from its body's centre of mass (m): how far
+    /// a turn of one radian can move a point of it. Infinite for an unbounded shape.
+    pub fn reach_radius(&self) -> f32 {
+        if self.is_unbounded() {
+            return f32::INFINITY;
+        }
+        let sphere = self.shape.compute_bounding_sphere(&self.local_pose);
+        sphere.center.length() + sphere.radius
+    }
+
+    /// How far a turn of `body` at its current angular velocity can move a point of this
+    /// collider in `dt` seconds (m): |ω|·[`Collider::reach_radius`]·dt; zero for a body that
+    /// does not turn (an unbounded collider is always on a fixed body).
+    pub fn turn_reach(&self, body: &RigidBody, dt: f32) -> f32 {
+        let spin = body.angular_velocity.length();
+        if spin > 0.0 {
+            spin * self.reach_radius() * dt
+        } else {
+            0.0
+        }
+    }
 }
 
 /// The pose of a body's centre-of-mass frame.

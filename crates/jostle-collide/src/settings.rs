@@ -53,8 +53,10 @@ pub struct CollideSettings {
     serde(default, deny_unknown_fields)
 )]
 pub struct CcdSettings {
-    /// Whether CCD runs at all. Default true. When false the CCD stage returns at once and
-    /// every body may tunnel through geometry thinner than one step's motion.
+    /// Whether CCD runs at all. Default true. When false the CCD stage returns at once, the
+    /// speculative contacts that grow with speed are not looked for (the broad and narrow
+    /// phase use the plain prediction distance: `NarrowPhase::update_swept` with no step),
+    /// and every body may tunnel through geometry thinner than one step's motion.
     pub enabled: bool,
     /// Motion fraction (dimensionless). Default 0.25.
     ///

@@ -256,6 +256,36 @@ fn margin_widens_the_test() {
 }
 
 #[test]
+fn a_swept_box_covers_the_step_of_a_fast_body() {
+    let mut scene = Scene::new();
+    scene.dynamic(&ShapeDesc::Ball { radius: 0.5 }, Vec3::ZERO);
+    let fast = scene.dynamic(&ShapeDesc::Ball { radius: 0.5 }, Vec3::new(2.0, 0.0, 0.0));
+    // 30 m/s toward the other ball: 0.5 m per step of 1/60 s, enough to close the 1 m gap
+    // only over two steps; at 90 m/s (1.5 m) within one.
+    for (speed, pairs) in [(30.0, 0), (90.0, 1)] {
+        scene.bodies.get_mut(fast).unwrap().linear_velocity = Vec3::new(-speed, 0.0, 0.0);
+        let swept = scene
+            .broad
+            .update_swept(&scene.colliders, &scene.bodies, 0.02, 1.0 / 60.0)
+            .len();
+        assert_eq!(swept, pairs, "{speed} m/s");
+        // Unswept, the boxes are apart.
+        let plain = scene
+            .broad
+            .update(&scene.colliders, &scene.bodies, 0.02)
+            .len();
+        assert_eq!(plain, 0, "{speed} m/s");
+    }
+    // Moving away, the swept box grows away from the other ball: no pair.
+    scene.bodies.get_mut(fast).unwrap().linear_velocity = Vec3::new(90.0, 0.0, 0.0);
+    let away = scene
+        .broad
+        .update_swept(&scene.colliders, &scene.bodies, 0.02, 1.0 / 60.0)
+        .len();
+    assert_eq!(away, 0);
+}
+
+#[test]
 fn a_sleeping_body_costs_no_pair_with_the_ground() {
     let mut scene = Scene::new();
     scene.fixed(&ground(), Vec3::ZERO);

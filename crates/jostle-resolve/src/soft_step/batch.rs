@@ -171,6 +171,14 @@ pub struct Batches {
     kept: Vec<u32>,
 }
 
+/// How fast the bodies of `c` close its gap at its points (m/s; 0 when they do not): the
+/// relative velocity of A's point toward B's along the normal.
+fn closing(c: &Contact, a: &SolverBody, b: &SolverBody) -> f32 {
+    let va = a.linear_velocity + a.angular_velocity.cross(c.point - a.position);
+    let vb = b.linear_velocity + b.angular_velocity.cross(c.point_b - b.position);
+    (vb - va).dot(c.normal).max(0.0)
+}
+
 /// A manifold before packing: a run of prepared contacts and its colour.
 #[derive(Clone, Copy, Debug)]
 struct Run {
@@ -188,9 +196,10 @@ impl Run {
 }
 
 impl Batches {
-    /// Prepares and packs the contacts of one step: those with a gap of at most
-    /// `speculative_margin` (m) between two bodies of which at least one can move; the
-    /// others take no part.
+    /// Prepares and packs the contacts of one step: those between two bodies of which at
+    /// least one can move, with a gap of at most `speculative_margin` (m), or of at most
+    /// the margin plus what the bodies close within [`PrepareParams::step`] at their
+    /// velocities (a speculative contact ahead of a fast body); the others take no part.
     pub fn pack(
         &mut self,
         contacts: &[Contact],
@@ -212,7 +221,11 @@ impl Batches {
         self.any_restitution = false;
         for (i, c) in contacts.iter().enumerate() {
             let (ba, bb) = (&bodies[c.a as usize], &bodies[c.b as usize]);
-            if -c.penetration <= speculative_margin && (ba.is_movable() || bb.is_movable()) {
+            let gap = -c.penetration;
+            let within = gap <= speculative_margin
+                || (params.step > 0.0
+                    && gap <= speculative_margin + closing(c, ba, bb) * params.step);
+            if within && (ba.is_movable() || bb.is_movable()) {
                 debug_assert_ne!(c.a, c.b, "a contact needs two different bodies");
                 debug_assert!(
                     (c.normal.length_squared() - 1.0).abs() < 1e-3,
@@ -441,6 +454,7 @@ mod tests {
             warm_scale: 0.25,
             preload_ramp: 0.0,
             preload_bound: 0.0,
+            step: 0.0,
         }
     }
 

@@ -469,6 +469,7 @@ impl SoftStepResolver {
             } else {
                 0.0
             },
+            step: h * s.substeps.max(1) as f32,
         };
         self.batches
             .pack(contacts, bodies, s.speculative_margin, &params);

@@ -35,6 +35,11 @@ pub struct PrepareParams {
     /// much the preload may stiffen a point under its load ([`prepare_point`]); 0 turns the
     /// preload off.
     pub preload_bound: f32,
+    /// The step (s) within which a contact beyond the speculative margin may still close its
+    /// gap: such a contact takes part when its bodies, at their velocities at the start of
+    /// the step, close the gap beyond the margin within it ([`super::Batches::pack`]); 0:
+    /// none beyond the margin.
+    pub step: f32,
 }
 
 /// The step-start state of eight bodies, by lane, as preparation reads it.
@@ -291,6 +296,7 @@ mod tests {
             warm_scale: 0.25,
             preload_ramp: 0.0,
             preload_bound: 0.0,
+            step: 0.0,
         };
         let mut batches = Batches::default();
         batches.pack(&scene.contacts, &scene.bodies, 0.02, &params);
@@ -346,6 +352,7 @@ mod tests {
             warm_scale: 0.25,
             preload_ramp: 0.0,
             preload_bound: 0.0,
+            step: 0.0,
         };
         for _ in 0..50 {
             let contacts: Vec<Contact> = (0..WIDTH - 1)

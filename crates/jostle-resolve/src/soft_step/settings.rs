@@ -56,7 +56,10 @@ pub struct SoftStepSettings {
     pub push_out_slop: f32,
     /// Gap (m) up to which a separated contact takes part as a speculative constraint (it
     /// stops the bodies from closing more than the gap within a substep). Default 0.02, the
-    /// narrow phase's prediction distance. Contacts with a larger gap are ignored.
+    /// narrow phase's prediction distance. A contact with a larger gap takes part only when
+    /// its bodies close that gap beyond the margin within the step at their velocities at
+    /// its start (the speculative contacts the facade's narrow phase finds ahead of fast
+    /// bodies); the others are ignored.
     pub speculative_margin: f32,
     /// Approach speed (m/s) above which restitution applies. Default 1. Slower impacts are
     /// perfectly inelastic, so resting contacts do not jitter.

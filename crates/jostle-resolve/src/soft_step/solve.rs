@@ -1486,6 +1486,7 @@ mod tests {
             warm_scale: 0.25,
             preload_ramp: 2000.0,
             preload_bound: 1600.0 * 9.81 * h,
+            step: 0.0,
         };
         let mut batches = Batches::default();
         // Preloads on every contact, so the kernels' preload path is exercised too.
