@@ -117,6 +117,10 @@ pub struct BodyDesc {
     /// than this total normal force in a step (N; [`crate::World::contact_force_events`]).
     /// Default: none.
     pub force_event_threshold: Option<f32>,
+    /// Further colliders, attached in order as [`crate::World::add_collider`] attaches them
+    /// (their poses in the body's own frame, their mass summed with the shape's). Default:
+    /// none.
+    pub colliders: Vec<crate::ColliderDesc>,
 }
 
 /// How a kinematic body moves ([`BodyDesc::kinematic`], scene field `kinematic`). Its mass
@@ -205,6 +209,7 @@ impl BodyDesc {
             sensor: false,
             groups: CollisionGroups::ALL,
             force_event_threshold: None,
+            colliders: Vec::new(),
         }
     }
 
@@ -400,7 +405,25 @@ impl BodyDesc {
                     .map_err(|(field, message)| err(&format!("kinematic.{field}"), message))?;
             }
         }
+        for (i, c) in self.colliders.iter().enumerate() {
+            let field = |f: &str| format!("colliders[{i}].{f}");
+            c.validate()
+                .map_err(|(f, message)| err(&field(&f), message))?;
+            c.shape
+                .build()
+                .map_err(|e| err(&field(&format!("shape.{}", e.field())), e.to_string()))?;
+            if !self.fixed && c.density > 0.0 && c.shape.can_be_dynamic() {
+                shape_mass(&c.shape, MassSpec::Density(c.density))
+                    .map_err(|(f, message)| err(&field(&f), message))?;
+            }
+        }
         Ok(())
+    }
+
+    /// With a further collider ([`BodyDesc::colliders`]).
+    pub fn with_collider(mut self, collider: crate::ColliderDesc) -> Self {
+        self.colliders.push(collider);
+        self
     }
 }
 

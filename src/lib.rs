@@ -25,6 +25,7 @@
 #![deny(missing_docs)]
 
 pub mod body_desc;
+pub mod collider_desc;
 pub mod profile;
 #[cfg(feature = "scene")]
 pub mod scene;
@@ -38,6 +39,7 @@ pub use body_desc::{
     BodyDesc, BodyError, Kinematic, MAX_ANGULAR_SPEED, MAX_DENSITY, MAX_DT, MAX_GRAVITY, MAX_MASS,
     MAX_POSITION, MAX_SPEED, MassSpec,
 };
+pub use collider_desc::ColliderDesc;
 pub use jostle_body::{BodyHandle, BodyType, CcdMode, KinematicPath, RigidBody};
 pub use jostle_collide::{
     BodyContact, CollideSettings, Collider, CollisionEvent, CollisionGroups, Combine,

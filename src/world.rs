@@ -8,6 +8,7 @@ use crate::body_desc::{
     BodyDesc, BodyError, DEFAULT_DENSITY, MAX_GRAVITY, MassSpec, check_force_threshold,
     check_material, shape_error, shape_mass, unit_rotation,
 };
+use crate::collider_desc::{ColliderDesc, LocalMass};
 use crate::profile::StepProfile;
 use crate::settings::{ResolverChoice, WorldSettings};
 use crate::stages::{self, Scratch};
@@ -17,7 +18,7 @@ use jostle_collide::{
     CollisionGroups, ContactForceEvent, Material, NarrowPhase, PairFilter, Queries, QueryFilter,
     RayHit, SensorEvent,
 };
-use jostle_math::{Quat, Vec3};
+use jostle_math::{Mat3, Quat, Vec3};
 use jostle_resolve::clock::Stopwatch;
 use jostle_resolve::{Resolver, StepContext};
 use jostle_sleep::IslandSet;
@@ -175,6 +176,7 @@ impl World {
             let mut body = body
                 .with_pose(com, rotation)
                 .with_velocity(desc.linear_velocity, desc.angular_velocity);
+            body.set_origin_offset(-props.local_com);
             if desc.lock_rotation {
                 body.lock_rotation();
             }
@@ -202,6 +204,7 @@ impl World {
             body.set_path(path);
         }
         let handle = self.bodies.insert(body);
+        let extra = desc.colliders;
         self.colliders.insert(
             Collider::new(shape, handle)
                 .with_desc(desc.shape)
@@ -211,6 +214,18 @@ impl World {
                 .with_sensor(desc.sensor)
                 .with_force_event_threshold(desc.force_event_threshold),
         );
+        for (i, c) in extra.into_iter().enumerate() {
+            // Validated with the description; should one still fail, nothing is left behind.
+            if let Err(e) = self.add_collider(handle, c) {
+                let name = self.bodies.get(handle).map(|b| b.name.clone());
+                let _ = self.remove_body(handle);
+                return Err(BodyError::Field {
+                    body: name.unwrap_or_default(),
+                    field: format!("colliders[{i}]"),
+                    message: e.to_string(),
+                });
+            }
+        }
         Ok(handle)
     }
 
@@ -280,6 +295,122 @@ impl World {
     /// The collider behind `handle`, or `None` if the handle is stale or invalid.
     pub fn collider(&self, handle: ColliderHandle) -> Option<&Collider> {
         self.colliders.get(handle)
+    }
+
+    /// Attaches a further collider to `body` ([`ColliderDesc`]: its own shape, pose in the
+    /// body's own frame — about [`RigidBody::origin`], the point the body's description placed
+    /// it at — material, density, groups, sensor flag) and returns its handle. On a dynamic
+    /// body its mass is added: the body's mass, centre of mass and inertia become the sums
+    /// over its colliders, its centre moves to the new centre of mass (every collider keeps
+    /// its place in the world) and its linear velocity becomes that of the point it moved to,
+    /// so momentum and angular momentum about any point are kept. On a fixed or kinematic
+    /// body the collider only moves with it. What the body touches wakes.
+    ///
+    /// ```
+    /// use jostle::{BodyDesc, ColliderDesc, ShapeDesc, Vec3, World, WorldSettings};
+    ///
+    /// let mut world = World::new(WorldSettings::default());
+    /// // A dumbbell: a bar with a ball at each end.
+    /// let bar = world
+    ///     .add_body(BodyDesc::dynamic("bar", ShapeDesc::Capsule { half_height: 0.5, radius: 0.05 })
+    ///         .rotated(jostle::Quat::from_rotation_z(std::f32::consts::FRAC_PI_2)))
+    ///     .unwrap();
+    /// for y in [-0.6, 0.6] {
+    ///     world
+    ///         .add_collider(bar, ColliderDesc::new(ShapeDesc::Ball { radius: 0.2 }).at(Vec3::new(0.0, y, 0.0)))
+    ///         .unwrap();
+    /// }
+    /// assert_eq!(world.colliders_of(bar).len(), 3);
+    /// // Symmetric: the centre of mass stays at the bar's middle.
+    /// assert!(world.body(bar).unwrap().position.length() < 1e-5);
+    /// ```
+    pub fn add_collider(
+        &mut self,
+        body: BodyHandle,
+        desc: ColliderDesc,
+    ) -> Result<ColliderHandle, StepError> {
+        let b = self
+            .bodies
+            .get(body)
+            .ok_or(StepError::InvalidHandle(body))?;
+        desc.validate()
+            .map_err(|(field, message)| StepError::Invalid {
+                field: format!("collider.{field}"),
+                message,
+            })?;
+        let shape = desc.shape.build().map_err(|e| StepError::Invalid {
+            field: format!("collider.shape.{}", e.field()),
+            message: e.to_string(),
+        })?;
+        let rotation = unit_rotation(desc.rotation).unwrap_or(Quat::IDENTITY);
+        // The description's position is on the body's own frame, whose origin sits at
+        // `origin_offset` from the centre of mass.
+        let at = b.origin_offset() + desc.position;
+        let mut local = jostle_collide::Pose::from_parts(at, rotation);
+        let adds_mass =
+            b.body_type() == BodyType::Dynamic && desc.density > 0.0 && desc.shape.can_be_dynamic();
+        if adds_mass {
+            let part = shape_mass(&desc.shape, MassSpec::Density(desc.density)).map_err(
+                |(field, message)| StepError::Invalid {
+                    field: format!("collider.{field}"),
+                    message,
+                },
+            )?;
+            let (mass, inertia) = b
+                .mass_properties()
+                .ok_or_else(|| invalid(("collider", "the body has no mass properties".into())))?;
+            let whole = LocalMass {
+                mass,
+                com: Vec3::ZERO,
+                inertia,
+            }
+            .plus(&LocalMass::of_part(&part, at, rotation));
+            let shift = whole.com;
+            self.move_centre_of_mass(body, shift, whole.mass, whole.inertia)?;
+            local = jostle_collide::Pose::from_parts(at - shift, rotation);
+        }
+        self.wake_around(body);
+        self.stamp += 1;
+        Ok(self.colliders.insert(
+            Collider::new(shape, body)
+                .with_desc(desc.shape)
+                .with_local_pose(local)
+                .with_material(desc.material)
+                .with_groups(desc.groups)
+                .with_sensor(desc.sensor)
+                .with_force_event_threshold(desc.force_event_threshold),
+        ))
+    }
+
+    /// Moves `body`'s centre of mass by `shift` (body frame) without moving its colliders in
+    /// the world, and gives it `mass` and the body-space `inertia` about the new centre; the
+    /// linear velocity becomes that of the new centre.
+    fn move_centre_of_mass(
+        &mut self,
+        body: BodyHandle,
+        shift: Vec3,
+        mass: f32,
+        inertia: Mat3,
+    ) -> Result<(), StepError> {
+        for c in self.colliders.attached(body) {
+            if let Some(collider) = self.colliders.get_mut(c) {
+                let pose = collider.local_pose();
+                collider.set_local_pose(jostle_collide::Pose::from_parts(
+                    pose.translation - shift,
+                    pose.rotation,
+                ));
+            }
+        }
+        let b = self
+            .bodies
+            .get_mut(body)
+            .ok_or(StepError::InvalidHandle(body))?;
+        let world_shift = b.orientation * shift;
+        b.position += world_shift;
+        b.set_origin_offset(b.origin_offset() - shift);
+        b.linear_velocity += b.angular_velocity.cross(world_shift);
+        b.set_mass_properties(mass, inertia)
+            .map_err(|e| invalid(("mass", e.to_string())))
     }
 
     /// Removes one collider and returns it; its body stays, with the mass it had (a body
@@ -643,9 +774,12 @@ impl World {
         Ok(())
     }
 
-    /// Gives a dynamic body new mass properties from its shape: a total mass (inertia scaled
-    /// from the shape's at uniform density) or a density, as [`BodyDesc`] takes them. The pose
-    /// and velocities are kept (momentum is not: a heavier body moves as fast as before).
+    /// Gives a dynamic body new mass properties from its colliders' shapes: a total mass
+    /// (inertia scaled from the shapes' at one uniform density) or a density for all of them,
+    /// as [`BodyDesc`] takes them; with several colliders the parts are summed and the body's
+    /// centre moves to their centre of mass as in [`World::add_collider`]. The orientation
+    /// and angular velocity are kept (momentum is not: a heavier body moves as fast as
+    /// before).
     /// Refused for a fixed body ([`World::set_fixed`] makes it dynamic) and for limits a scene
     /// file refuses; wakes the body.
     pub fn set_mass(&mut self, handle: BodyHandle, mass: MassSpec) -> Result<(), StepError> {
@@ -659,10 +793,10 @@ impl World {
                 "a fixed body has no mass: make it dynamic first (World::set_fixed)".into(),
             )));
         }
-        let props = self.shape_mass_of(handle, mass)?;
-        self.body_mut_awake(handle)?
-            .set_mass_properties(props.mass, props.inertia)
-            .map_err(|e| invalid(("mass", e.to_string())))
+        crate::body_desc::check_mass(mass).map_err(|(f, m)| invalid((f, m)))?;
+        let sum = self.summed_mass(handle, mass)?;
+        self.body_mut_awake(handle)?;
+        self.move_centre_of_mass(handle, sum.com, sum.mass, sum.inertia)
     }
 
     /// Makes a body fixed (immovable, at rest) or dynamic again:
@@ -741,28 +875,14 @@ impl World {
             )));
         }
         let first_mass = if needs_mass {
-            Some(self.shape_mass_of(handle, MassSpec::Density(DEFAULT_DENSITY))?)
+            Some(self.summed_mass(handle, MassSpec::Density(DEFAULT_DENSITY))?)
         } else {
             None
         };
         self.wake_around(handle);
-        let body = self
-            .bodies
-            .get_mut(handle)
-            .ok_or(StepError::InvalidHandle(handle))?;
-        if let Some(props) = first_mass {
-            body.set_mass_properties(props.mass, props.inertia)
-                .map_err(|e| invalid(("mass", e.to_string())))?;
+        if let Some(sum) = first_mass {
             // The body's origin becomes its centre of mass; its colliders stay where they are.
-            let offset = props.local_com;
-            body.position += body.orientation * offset;
-            for c in &colliders {
-                if let Some(collider) = self.colliders.get_mut(*c) {
-                    let moved =
-                        jostle_collide::Pose::from_translation(-offset) * collider.local_pose();
-                    collider.set_local_pose(moved);
-                }
-            }
+            self.move_centre_of_mass(handle, sum.com, sum.mass, sum.inertia)?;
         }
         let body = self
             .bodies
@@ -940,27 +1060,45 @@ impl World {
 
     /// The mass properties of a body's shape given as `mass` (its one collider's
     /// description).
-    fn shape_mass_of(
-        &self,
-        handle: BodyHandle,
-        mass: MassSpec,
-    ) -> Result<jostle_collide::MassProps, StepError> {
-        let colliders = self.colliders.attached(handle);
-        let [collider] = colliders.as_slice() else {
-            return Err(invalid((
-                "shape",
-                format!(
-                    "mass properties need exactly one collider, the body has {}",
-                    colliders.len()
-                ),
-            )));
+    /// The mass properties of `handle`'s colliders summed in the body's frame, each at the
+    /// density of `mass` (`MassSpec::Density`), or all at one density scaled so that they
+    /// weigh `MassSpec::Mass` together. Colliders whose shape has no volume (half-spaces)
+    /// add nothing; a body with no collider that has one is refused.
+    fn summed_mass(&self, handle: BodyHandle, mass: MassSpec) -> Result<LocalMass, StepError> {
+        let density = match mass {
+            MassSpec::Density(d) => MassSpec::Density(d),
+            MassSpec::Mass(_) => MassSpec::Density(1.0),
         };
-        let desc = self
-            .colliders
-            .get(*collider)
-            .and_then(|c| c.desc())
-            .ok_or(StepError::InvalidCollider(*collider))?;
-        shape_mass(desc, mass).map_err(|(field, message)| StepError::Invalid { field, message })
+        let mut sum: Option<LocalMass> = None;
+        for c in self.colliders.attached(handle) {
+            let collider = self.colliders.get(c).ok_or(StepError::InvalidCollider(c))?;
+            let Some(desc) = collider.desc() else {
+                continue;
+            };
+            if !desc.can_be_dynamic() {
+                continue;
+            }
+            let part = shape_mass(desc, density)
+                .map_err(|(field, message)| StepError::Invalid { field, message })?;
+            let pose = collider.local_pose();
+            let part = LocalMass::of_part(&part, pose.translation, pose.rotation);
+            sum = Some(match sum {
+                Some(s) => s.plus(&part),
+                None => part,
+            });
+        }
+        let mut sum = sum.ok_or_else(|| {
+            invalid((
+                "shape",
+                "the body has no collider with a volume to take mass from".into(),
+            ))
+        })?;
+        if let MassSpec::Mass(m) = mass {
+            let scale = m / sum.mass;
+            sum.mass = m;
+            sum.inertia *= scale;
+        }
+        Ok(sum)
     }
 
     /// Simulated time (s) and steps taken.

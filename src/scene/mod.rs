@@ -249,6 +249,42 @@ pub struct BodySpec {
     /// Report contact force events above this total normal force (N). Default: none.
     #[serde(default)]
     pub force_event_threshold: Option<f32>,
+    /// Further colliders of the body (`colliders: [Collider(shape: Ball(radius: 0.2),
+    /// position: (0.0, 0.6, 0.0))]`), placed in the body's own frame, their mass summed with
+    /// the shape's ([`crate::World::add_collider`]). Default: none.
+    #[serde(default)]
+    pub colliders: Vec<ColliderSpec>,
+}
+
+/// One further collider of a scene body (`Collider(...)` in a body's `colliders`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename = "Collider", deny_unknown_fields)]
+pub struct ColliderSpec {
+    /// Shape (required; not a half-space).
+    pub shape: ShapeDesc,
+    /// Position (m) of the shape's origin in the body's own frame (about the body's
+    /// `position`, along its rotated axes). Default: the body's position.
+    #[serde(default)]
+    pub position: Vec3,
+    /// Orientation in the body's frame, as (x, y, z, w). Default: none.
+    #[serde(default = "identity")]
+    pub rotation: Quat,
+    /// Friction μ. Default: the body's.
+    #[serde(default)]
+    pub friction: Option<f32>,
+    /// Restitution e. Default: the body's.
+    #[serde(default)]
+    pub restitution: Option<f32>,
+    /// Density (kg/m³) of the mass it adds; 0 adds none. Default: the body's density, or
+    /// 1000 when the body gives a mass instead.
+    #[serde(default)]
+    pub density: Option<f32>,
+    /// A sensor. Default false.
+    #[serde(default)]
+    pub sensor: bool,
+    /// Collision groups. Default: the body's.
+    #[serde(default)]
+    pub groups: Option<jostle_collide::CollisionGroups>,
 }
 
 fn identity() -> Quat {
@@ -295,6 +331,37 @@ impl BodySpec {
             sensor: self.sensor,
             groups: self.groups,
             force_event_threshold: self.force_event_threshold,
+            colliders: Vec::new(),
+        };
+        let body_density = match mass {
+            MassSpec::Density(d) => d,
+            MassSpec::Mass(_) => crate::body_desc::DEFAULT_DENSITY,
+        };
+        let desc = BodyDesc {
+            colliders: self
+                .colliders
+                .iter()
+                .map(|c| crate::ColliderDesc {
+                    shape: c.shape.clone(),
+                    position: c.position,
+                    rotation: c.rotation,
+                    material: Material {
+                        friction: c.friction.unwrap_or(desc.material.friction),
+                        restitution: c.restitution.unwrap_or(desc.material.restitution),
+                        // A friction of its own has its own dynamic coefficient (the same).
+                        dynamic_friction: match c.friction {
+                            Some(_) => None,
+                            None => desc.material.dynamic_friction,
+                        },
+                        ..desc.material
+                    },
+                    density: c.density.unwrap_or(body_density),
+                    groups: c.groups.unwrap_or(desc.groups),
+                    sensor: c.sensor,
+                    force_event_threshold: None,
+                })
+                .collect(),
+            ..desc
         };
         desc.validate()?;
         Ok(desc)

@@ -133,6 +133,11 @@ pub struct RigidBody {
     /// falls up).
     #[cfg_attr(feature = "serde", serde(default = "one"))]
     pub gravity_scale: f32,
+    /// Where the body's own frame has its origin, relative to its centre of mass along the
+    /// body's axes (m): the point its description placed it at, which stays put on the body
+    /// when colliders added later move the centre of mass ([`RigidBody::origin`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    origin_offset: Vec3,
 }
 
 #[cfg(feature = "serde")]
@@ -362,6 +367,7 @@ impl RigidBody {
             next_pose: None,
             path: None,
             gravity_scale: 1.0,
+            origin_offset: Vec3::ZERO,
         }
     }
 
@@ -406,6 +412,32 @@ impl RigidBody {
         } else {
             self.mass
         }
+    }
+
+    /// The world position of the body's own origin (m): the point its description placed it
+    /// at, which need not be its centre of mass ([`RigidBody::position`]) and does not move
+    /// on the body when colliders are added.
+    pub fn origin(&self) -> Vec3 {
+        self.position + self.orientation * self.origin_offset
+    }
+
+    /// The body's origin relative to its centre of mass, along the body's axes (m).
+    pub fn origin_offset(&self) -> Vec3 {
+        self.origin_offset
+    }
+
+    /// Sets [`RigidBody::origin_offset`] (the centre of mass moved on the body by `−offset`
+    /// from the origin; the pose is unchanged).
+    pub fn set_origin_offset(&mut self, offset: Vec3) {
+        self.origin_offset = offset;
+    }
+
+    /// The mass (kg) and body-space inertia tensor (kg·m², about the centre of mass) the
+    /// body has, or keeps while fixed or kinematic; `None` for a body that was never dynamic
+    /// ([`RigidBody::fixed`]).
+    pub fn mass_properties(&self) -> Option<(f32, Mat3)> {
+        self.has_mass_properties()
+            .then_some((self.mass, self.inertia_body))
     }
 
     /// Whether the body has (or, fixed, keeps) finite mass properties: false for a body that
