@@ -508,6 +508,7 @@ impl RigidBody {
         vector("angular_velocity", self.angular_velocity)?;
         vector("last_acceleration", self.last_acceleration)?;
         vector("force", self.force)?;
+        vector("origin_offset", self.origin_offset)?;
         if let Some(path) = &self.path {
             path.check()
                 .map_err(|(field, message)| ("path", format!("{field} {message}")))?;
