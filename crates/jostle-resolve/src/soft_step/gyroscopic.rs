@@ -28,7 +28,7 @@ pub fn inertia_of(inv_inertia: Mat3) -> Option<Mat3> {
 
 /// Relative anisotropy below which [`is_isotropic`] calls an inertia the same about every
 /// axis. The term's change to ω per turn is about the anisotropy times the turn, so at 10⁻⁵
-/// it is below f32 rounding for any turn of at most [`MAX_PIECE_ANGLE`] per piece.
+/// it is below f32 rounding for any turn of at most `MAX_PIECE_ANGLE` per piece.
 pub const ISOTROPY_TOLERANCE: f32 = 1e-5;
 
 /// Whether the world inverse inertia `inv_inertia` is a multiple of the identity to within

@@ -46,7 +46,7 @@ pub const GYROSCOPIC_CUTOFF: f32 = 1e-5;
 /// With `gyro` (each body's world inertia at the start of the step, zero for a body without
 /// one; and the step-start world inverse inertia its contact rows use, zero for a body
 /// without contact rows) this is also where the gyroscopic term acts
-/// ([`turn_against`](super::gyroscopic::turn_against)): a body that turns by at least
+/// (`gyroscopic::turn_against`): a body that turns by at least
 /// [`GYROSCOPIC_CUTOFF`] keeps its world angular momentum L = I·ω through the turn, its ω
 /// recomputed from L at the new orientation, unless its inertia has turned too far from the
 /// one its contact rows use.

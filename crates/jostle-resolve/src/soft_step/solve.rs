@@ -624,8 +624,8 @@ const fn below(i: usize, j: usize) -> usize {
     i * (i - 1) / 2 + j
 }
 
-/// Factors each batch's block system for [`relax_block`], once per step: K = J·M⁻¹·Jᵀ over
-/// the batch's points (lane by lane), plus ε·diag(K) ([`BLOCK_REGULARISATION`]), as L·Lᵀ into
+/// Factors each batch's block system for `relax_block`, once per step: K = J·M⁻¹·Jᵀ over
+/// the batch's points (lane by lane), plus ε·diag(K) (`BLOCK_REGULARISATION`), as L·Lᵀ into
 /// [`ManifoldLanes::block`]. A padding point (no row) gets an identity row. The Jacobians and
 /// masses are the step's, fixed through its substeps.
 pub fn factor_blocks(batches: &mut Batches) {
@@ -1166,7 +1166,7 @@ fn two_batches<'a, F>(
 /// through is removed again once the positions moved (speculative contacts keep their gap
 /// rule); `sweeps` > 1 sweeps each manifold's normal rows that often before its friction
 /// (rigid contacts); with `block`, each manifold's normal rows are solved together
-/// ([`relax_block`], after [`factor_blocks`]).
+/// (`relax_block`, after [`factor_blocks`]).
 pub fn relax(
     batches: &mut Batches,
     states: &mut [BodyState],
