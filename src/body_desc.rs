@@ -104,6 +104,10 @@ pub struct BodyDesc {
     /// resolvers skip its angular terms). Default false. `angular_velocity` must then be zero.
     /// Ignored for fixed bodies.
     pub lock_rotation: bool,
+    /// Lock rotation about some world axes (x, y, z) only
+    /// ([`jostle_body::RigidBody::set_rotation_locks`]). Default: none. `angular_velocity`
+    /// must be zero about each locked axis. Ignored for fixed bodies.
+    pub rotation_locks: [bool; 3],
     /// Makes the body kinematic: moved by its velocity, to the poses it is sent to, or along
     /// a path; it pushes dynamic bodies and nothing pushes it. `None` (the default): dynamic,
     /// or fixed with `fixed`.
@@ -205,6 +209,7 @@ impl BodyDesc {
             fixed: false,
             ccd: CcdMode::Auto,
             lock_rotation: false,
+            rotation_locks: [false; 3],
             kinematic: None,
             sensor: false,
             groups: CollisionGroups::ALL,
@@ -361,6 +366,18 @@ impl BodyDesc {
                 ),
             ));
         }
+        for (axis, name) in ["x", "y", "z"].iter().enumerate() {
+            if self.rotation_locks[axis] && !self.fixed && self.angular_velocity[axis] != 0.0 {
+                return Err(err(
+                    "angular_velocity",
+                    format!(
+                        "must have no {name} component when rotation about {name} is locked, \
+                         got {}",
+                        self.angular_velocity
+                    ),
+                ));
+            }
+        }
         if unit_rotation(self.rotation).is_none() {
             return Err(err(
                 "rotation",
@@ -418,6 +435,13 @@ impl BodyDesc {
             }
         }
         Ok(())
+    }
+
+    /// With rotation about the world axes marked `true` (x, y, z) locked
+    /// ([`BodyDesc::rotation_locks`]).
+    pub fn with_rotation_locks(mut self, locks: [bool; 3]) -> Self {
+        self.rotation_locks = locks;
+        self
     }
 
     /// With a further collider ([`BodyDesc::colliders`]).

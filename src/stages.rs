@@ -8,7 +8,7 @@ use jostle_collide::{
     BodyContact, BroadPhase, CcdSettings, CcdShape, ColliderHandle, ColliderSet, Material,
     NarrowPhase, Pose,
 };
-use jostle_math::{Mat3, Vec3, skew, world_inverse_inertia};
+use jostle_math::{Mat3, Vec3, skew};
 use jostle_resolve::{Contact, STATIC_BODY, SolverBody};
 use jostle_sleep::{IslandSet, SleepSettings, update_motion};
 
@@ -406,7 +406,7 @@ pub(crate) fn ccd(
         if let Some(c) = contact {
             let turn = at.rotation * end.orientation.inverse();
             let w = turn * end.angular_velocity;
-            let inv_inertia = world_inverse_inertia(at.rotation, start.inv_inertia_body());
+            let inv_inertia = start.inv_inertia_world_at(at.rotation);
             let (v, w) = impact_velocity(
                 (end.linear_velocity, w),
                 end.inv_mass,
@@ -601,7 +601,8 @@ pub(crate) fn scatter(
         body.position = solver.position;
         body.orientation = solver.orientation;
         body.linear_velocity = solver.linear_velocity;
-        body.angular_velocity = solver.angular_velocity;
+        // (A locked axis gains no turn in the solve but for rounding, which is dropped.)
+        body.angular_velocity = body.without_locked_turn(solver.angular_velocity);
         body.last_acceleration = solver.last_acceleration;
         body.update_world_inertia();
     }

@@ -179,6 +179,8 @@ impl World {
             body.set_origin_offset(-props.local_com);
             if desc.lock_rotation {
                 body.lock_rotation();
+            } else if desc.rotation_locks != [false; 3] {
+                body.set_rotation_locks(desc.rotation_locks);
             }
             (
                 body,
@@ -595,7 +597,7 @@ impl World {
         let body = self.body_mut_awake(handle)?;
         body.linear_velocity = linear;
         if !body.is_rotation_locked() {
-            body.angular_velocity = angular;
+            body.angular_velocity = body.without_locked_turn(angular);
         }
         Ok(())
     }
@@ -1003,6 +1005,41 @@ impl World {
     /// Sets a body's continuous collision detection mode; wakes it.
     pub fn set_ccd(&mut self, handle: BodyHandle, mode: CcdMode) -> Result<(), StepError> {
         self.body_mut_awake(handle)?.ccd = mode;
+        Ok(())
+    }
+
+    /// Locks (or, with `false`, unlocks) a body's rotation about each world axis (x, y, z)
+    /// ([`RigidBody::set_rotation_locks`]): its angular velocity loses the locked components
+    /// and nothing turns it about them any more. Wakes the body. Refused for a fixed body.
+    ///
+    /// ```
+    /// use jostle::{BodyDesc, ShapeDesc, Vec3, World, WorldSettings};
+    ///
+    /// let mut world = World::new(WorldSettings { gravity: Vec3::ZERO, ..Default::default() });
+    /// let top = world.add_body(BodyDesc::dynamic("top", ShapeDesc::Cuboid { half_extents: Vec3::splat(0.5) })).unwrap();
+    /// world.set_rotation_locks(top, [true, false, true]).unwrap();
+    /// // A push at a corner: it turns about the vertical only.
+    /// world.apply_impulse_at_point(top, Vec3::new(0.0, 0.0, 100.0), Vec3::new(0.5, 0.5, 0.0)).unwrap();
+    /// let w = world.body(top).unwrap().angular_velocity;
+    /// assert!(w.x == 0.0 && w.z == 0.0 && w.y != 0.0);
+    /// ```
+    pub fn set_rotation_locks(
+        &mut self,
+        handle: BodyHandle,
+        locks: [bool; 3],
+    ) -> Result<(), StepError> {
+        if self
+            .bodies
+            .get(handle)
+            .ok_or(StepError::InvalidHandle(handle))?
+            .is_fixed()
+        {
+            return Err(invalid((
+                "rotation_locks",
+                "a fixed body does not turn: make it dynamic first".into(),
+            )));
+        }
+        self.body_mut_awake(handle)?.set_rotation_locks(locks);
         Ok(())
     }
 

@@ -233,6 +233,10 @@ pub struct BodySpec {
     /// Lock the rotation (the body translates but never turns). Default false.
     #[serde(default)]
     pub lock_rotation: bool,
+    /// Lock rotation about some world axes only, `(x, y, z)`: `(true, false, true)` turns
+    /// about the vertical alone. Default: none.
+    #[serde(default)]
+    pub rotation_locks: [bool; 3],
     /// Makes the body kinematic (pushes dynamic bodies, pushed by nothing): `Velocity` (moved
     /// by `linear_velocity` and `angular_velocity`), `Position` (moved by the program),
     /// `Line(offset: (x, y, z), period: s)` (back and forth) or `Turn(center: (x, y, z),
@@ -327,6 +331,7 @@ impl BodySpec {
             fixed: self.fixed,
             ccd: self.ccd,
             lock_rotation: self.lock_rotation,
+            rotation_locks: self.rotation_locks,
             kinematic: self.kinematic,
             sensor: self.sensor,
             groups: self.groups,

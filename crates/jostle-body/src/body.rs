@@ -138,6 +138,9 @@ pub struct RigidBody {
     /// when colliders added later move the centre of mass ([`RigidBody::origin`]).
     #[cfg_attr(feature = "serde", serde(default))]
     origin_offset: Vec3,
+    /// Rotation about each world axis (x, y, z) locked ([`RigidBody::set_rotation_locks`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    rotation_locks: [bool; 3],
 }
 
 #[cfg(feature = "serde")]
@@ -368,6 +371,7 @@ impl RigidBody {
             path: None,
             gravity_scale: 1.0,
             origin_offset: Vec3::ZERO,
+            rotation_locks: [false; 3],
         }
     }
 
@@ -487,7 +491,56 @@ impl RigidBody {
     /// `orientation` directly.
     #[inline]
     pub fn update_world_inertia(&mut self) {
-        self.inv_inertia_world = world_inverse_inertia(self.orientation, self.inv_inertia_body);
+        self.inv_inertia_world = self.inv_inertia_world_at(self.orientation);
+    }
+
+    /// The world inverse inertia the body would have at `orientation`: R·I⁻¹·Rᵀ, with the
+    /// rows and columns of locked world axes zeroed ([`RigidBody::set_rotation_locks`]).
+    #[inline]
+    pub fn inv_inertia_world_at(&self, orientation: Quat) -> Mat3 {
+        let inv = world_inverse_inertia(orientation, self.inv_inertia_body);
+        if self.rotation_locks == [false; 3] {
+            inv
+        } else {
+            let p = Mat3::from_diagonal(self.unlocked_axes());
+            p * inv * p
+        }
+    }
+
+    /// 1 for each world axis the body may turn about, 0 for a locked one.
+    fn unlocked_axes(&self) -> Vec3 {
+        let free = |locked: bool| if locked { 0.0 } else { 1.0 };
+        Vec3::new(
+            free(self.rotation_locks[0]),
+            free(self.rotation_locks[1]),
+            free(self.rotation_locks[2]),
+        )
+    }
+
+    /// Locks rotation about some world axes (x, y, z): the world inverse inertia loses their
+    /// rows and columns, so no contact, impulse or torque turns the body about them, and the
+    /// angular velocity loses its components along them (a body locked about x and z turns
+    /// about the vertical only, a wheel that cannot tip). The stored inertia is kept; `[false;
+    /// 3]` unlocks. [`RigidBody::lock_rotation`] locks every axis the cheaper way.
+    pub fn set_rotation_locks(&mut self, locks: [bool; 3]) {
+        self.rotation_locks = locks;
+        self.angular_velocity = self.without_locked_turn(self.angular_velocity);
+        self.update_world_inertia();
+    }
+
+    /// Which world axes' rotation is locked ([`RigidBody::set_rotation_locks`]).
+    pub fn rotation_locks(&self) -> [bool; 3] {
+        self.rotation_locks
+    }
+
+    /// `omega` without its components about locked world axes.
+    #[inline]
+    pub fn without_locked_turn(&self, omega: Vec3) -> Vec3 {
+        if self.rotation_locks == [false; 3] {
+            omega
+        } else {
+            omega * self.unlocked_axes()
+        }
     }
 
     /// Checks a body that did not come from [`RigidBody::dynamic`] or [`RigidBody::fixed`] (a
