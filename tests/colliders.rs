@@ -103,18 +103,8 @@ fn a_turning_body_keeps_its_motion_when_its_centre_moves() {
 /// post's foot) tips over; without the ball it stands. Returns the post's tilt (rad) after
 /// 2 s.
 fn post_tips(resolver: &jostle::ResolverChoice, with_ball: bool) -> f32 {
-    let mut settings = WorldSettings {
-        resolver: resolver.clone(),
-        ..Default::default()
-    };
-    settings.sleep.enabled = false;
-    let mut world = World::new(settings);
-    world
-        .add_body(BodyDesc::fixed(
-            "ground",
-            ShapeDesc::HalfSpace { normal: Vec3::Y },
-        ))
-        .unwrap();
+    let mut world = common::world_with(Vec3::new(0.0, -9.81, 0.0), resolver);
+    common::ground(&mut world, 0.5, 0.0);
     let post = world
         .add_body(
             BodyDesc::dynamic(
@@ -166,16 +156,8 @@ fn an_off_centre_collider_tips_its_body_over() {
 #[test]
 fn an_added_collider_rests_on_the_ground() {
     for resolver in common::resolvers() {
-        let mut world = World::new(WorldSettings {
-            resolver: resolver.clone(),
-            ..Default::default()
-        });
-        world
-            .add_body(BodyDesc::fixed(
-                "ground",
-                ShapeDesc::HalfSpace { normal: Vec3::Y },
-            ))
-            .unwrap();
+        let mut world = common::world_with(Vec3::new(0.0, -9.81, 0.0), &resolver);
+        common::ground(&mut world, 0.5, 0.0);
         // A ball with a flat foot fixed 1 m below it: the foot lands first and holds it up.
         let body = world
             .add_body(BodyDesc::dynamic("top", ball(0.3)).at(Vec3::new(0.0, 3.0, 0.0)))

@@ -8,18 +8,8 @@ use jostle::{BodyDesc, ShapeDesc, Vec3, World, WorldSettings};
 /// A tall box on the ground knocked at its top corner: returns its largest angular speed
 /// about the horizontal axes and its largest tilt (rad) over 90 steps.
 fn knocked(resolver: &jostle::ResolverChoice, locks: [bool; 3]) -> (f32, f32) {
-    let mut settings = WorldSettings {
-        resolver: resolver.clone(),
-        ..Default::default()
-    };
-    settings.sleep.enabled = false;
-    let mut world = World::new(settings);
-    world
-        .add_body(BodyDesc::fixed(
-            "ground",
-            ShapeDesc::HalfSpace { normal: Vec3::Y },
-        ))
-        .unwrap();
+    let mut world = common::world_with(Vec3::new(0.0, -9.81, 0.0), resolver);
+    common::ground(&mut world, 0.5, 0.0);
     let post = world
         .add_body(
             BodyDesc::dynamic(
