@@ -18,6 +18,12 @@ use jostle_math::{Quat, Vec3};
 /// v2.1's and Bullet's position correction).
 pub type PseudoRow = [f32; 8];
 
+/// Flag of a [`BodyState`] (beside [`SolverBody::ROTATES`]): the body has no contact row this
+/// step, does not turn and has no force on it, so its substeps are nothing but free flight;
+/// the substep stages skip it and [`super::integrate::integrate_free`] integrates all of its
+/// substeps at once after them.
+pub const FREE: u32 = 1 << 8;
+
 /// Hot state of one body during a soft step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]

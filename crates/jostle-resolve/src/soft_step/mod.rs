@@ -160,6 +160,8 @@ pub struct SoftStepResolver {
     /// With the gyroscopic term: whether some contact of the step joins the body to a body
     /// that can move.
     touches_moving: Vec<bool>,
+    /// Scratch of `mark_free`: whether some batch holds the body.
+    bound: Vec<bool>,
     /// The prepared contacts packed eight manifolds to a batch for the kernels.
     batches: Batches,
     /// Normal impulses before the restitution pass, restored after it.
@@ -298,6 +300,30 @@ impl SoftStepResolver {
             }));
             if let Some(i) = self.inertia.get_mut(STATIC_BODY as usize) {
                 *i = Mat3::ZERO;
+            }
+        }
+    }
+
+    /// Marks [`body_state::FREE`] the bodies in no batch, not turning and without forces:
+    /// their substeps are integrated at once after the others' (`rain_1000`'s bodies in
+    /// flight, a dropped lattice before it lands).
+    fn mark_free(&mut self) {
+        self.bound.clear();
+        self.bound.resize(self.states.len(), false);
+        for m in &self.batches.manifolds {
+            for i in m.a.iter().chain(&m.b) {
+                if let Some(b) = self.bound.get_mut(*i as usize) {
+                    *b = true;
+                }
+            }
+        }
+        for (i, s) in self.states.iter_mut().enumerate().skip(1) {
+            let pushed = self
+                .pushes
+                .get(i)
+                .is_some_and(|[v, w]| *v != Vec3::ZERO || *w != Vec3::ZERO);
+            if !self.bound[i] && s.angular_velocity == Vec3::ZERO && !pushed {
+                s.flags |= body_state::FREE;
             }
         }
     }
@@ -792,6 +818,7 @@ impl Resolver for SoftStepResolver {
         self.load_bodies(bodies);
         let any_restitution = self.prepare_contacts(bodies, contacts, h, ctx.gravity.length());
         self.mark_contact_rows(bodies, contacts);
+        self.mark_free();
         if self.settings.block_relax && !self.settings.rigid_contacts {
             solve::factor_blocks(&mut self.batches);
         }
@@ -926,6 +953,7 @@ impl Resolver for SoftStepResolver {
             self.choice
                 .record(threads > 1, substeps_start.elapsed(), points);
         }
+        integrate::integrate_free(&mut self.states, ctx.gravity, h, substeps);
         let [integrate_time, solve_time, mut relax_time] = times;
         stats.threads = threads as u32;
         let t = Stopwatch::start();
