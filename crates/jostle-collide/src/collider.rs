@@ -40,6 +40,8 @@ pub struct Collider {
     pub force_event_threshold: Option<f32>,
     /// What CCD needs of the shape, computed whenever the shape or local pose is set.
     pub(crate) ccd: CcdShape,
+    /// [`Collider::reach_radius`], computed whenever the shape or local pose is set.
+    reach: f32,
     /// The description the shape was built from ([`Collider::from_desc`]), for snapshots.
     desc: Option<ShapeDesc>,
     /// The display mesh, built on first use.
@@ -74,6 +76,7 @@ impl Collider {
                 thickness: 0.0,
                 extent: 0.0,
             },
+            reach: 0.0,
             desc: None,
             display: OnceLock::new(),
         };
@@ -175,6 +178,12 @@ impl Collider {
     /// Recomputes what is derived from the shape and local pose.
     fn derive(&mut self) {
         self.ccd = CcdShape::of(self);
+        self.reach = if self.is_unbounded() {
+            f32::INFINITY
+        } else {
+            let sphere = self.shape.compute_bounding_sphere(&self.local_pose);
+            sphere.center.length() + sphere.radius
+        };
         self.display = OnceLock::new();
     }
 
@@ -197,17 +206,15 @@ impl Collider {
 
     /// The farthest any point of the shape lies from its body's centre of mass (m): how far
     /// a turn of one radian can move a point of it. Infinite for an unbounded shape.
+    #[inline]
     pub fn reach_radius(&self) -> f32 {
-        if self.is_unbounded() {
-            return f32::INFINITY;
-        }
-        let sphere = self.shape.compute_bounding_sphere(&self.local_pose);
-        sphere.center.length() + sphere.radius
+        self.reach
     }
 
     /// How far a turn of `body` at its current angular velocity can move a point of this
     /// collider in `dt` seconds (m): |ω|·[`Collider::reach_radius`]·dt; zero for a body that
     /// does not turn (an unbounded collider is always on a fixed body).
+    #[inline]
     pub fn turn_reach(&self, body: &RigidBody, dt: f32) -> f32 {
         let spin = body.angular_velocity.length();
         if spin > 0.0 {
