@@ -394,6 +394,17 @@ impl World {
         mass: f32,
         inertia: Mat3,
     ) -> Result<(), StepError> {
+        let b = self
+            .bodies
+            .get_mut(body)
+            .ok_or(StepError::InvalidHandle(body))?;
+        // First what can fail, which then changes nothing.
+        b.set_mass_properties(mass, inertia)
+            .map_err(|e| invalid(("mass", e.to_string())))?;
+        let world_shift = b.orientation * shift;
+        b.position += world_shift;
+        b.set_origin_offset(b.origin_offset() - shift);
+        b.linear_velocity += b.angular_velocity.cross(world_shift);
         for c in self.colliders.attached(body) {
             if let Some(collider) = self.colliders.get_mut(c) {
                 let pose = collider.local_pose();
@@ -403,16 +414,7 @@ impl World {
                 ));
             }
         }
-        let b = self
-            .bodies
-            .get_mut(body)
-            .ok_or(StepError::InvalidHandle(body))?;
-        let world_shift = b.orientation * shift;
-        b.position += world_shift;
-        b.set_origin_offset(b.origin_offset() - shift);
-        b.linear_velocity += b.angular_velocity.cross(world_shift);
-        b.set_mass_properties(mass, inertia)
-            .map_err(|e| invalid(("mass", e.to_string())))
+        Ok(())
     }
 
     /// Removes one collider and returns it; its body stays, with the mass it had (a body
