@@ -30,7 +30,11 @@
 //!    is balanced by the normal load's distribution, and a biased solve that moves the load
 //!    without it spun a light box at 80 rad/s). An active set: normal rows whose total would
 //!    pull are fixed at no impulse, friction that would leave its cone is fixed on it, and
-//!    the rest is solved again. The system is factorised
+//!    the rest is solved again. J·M⁻¹·Jᵀ is built in f64 from the rows and the bodies'
+//!    inverse inertia (built in f32 it lost the heavy body of a 1:10⁶ pair in rounding and
+//!    was not positive semi-definite: `Row::coupling`), and a solution is summed per body in
+//!    f64 and applied through the same inverse inertia (`Solver::apply`). The system is
+//!    factorised
 //!    by Cholesky in f64 (rows that depend on others, as the four points of a face do, get no
 //!    impulse of their own), once per step and free set, and the result goes to the bodies
 //!    and to the accumulated impulses; in the relax pass only if it takes kinetic energy out
@@ -49,8 +53,9 @@ use super::body_state::BodyState;
 use super::shared::share;
 use super::solve::{RowPass, RowState, row_residuals};
 use crate::STATIC_BODY;
+use crate::SolverBody;
 use crate::union_find::UnionFind;
-use jostle_math::Vec3;
+use jostle_math::{Mat3, Vec3};
 
 /// A pivot below this fraction of its row's diagonal marks the row as depending on the rows
 /// before it ([`cholesky_solve`]). Rows built from f32 data are dependent to about 1e-14 of
@@ -85,9 +90,6 @@ struct Row {
     /// r_A × d and r_B × d.
     rn_a: Vec3,
     rn_b: Vec3,
-    /// I_A⁻¹·(r_A × d) and I_B⁻¹·(r_B × d).
-    ang_a: Vec3,
-    ang_b: Vec3,
 }
 
 /// A point's normal row.
@@ -98,23 +100,44 @@ const TANGENT_1: u8 = 1;
 const TANGENT_2: u8 = 2;
 
 impl Row {
-    /// The change of this row's normal velocity per unit impulse on `other`: (J·M⁻¹·Jᵀ)ᵢⱼ.
-    fn coupling(&self, other: &Row) -> f64 {
+    /// The change of this row's normal velocity per unit impulse on `other`: (J·M⁻¹·Jᵀ)ᵢⱼ,
+    /// in f64 from each shared body's inverse mass and world inverse inertia
+    /// (`inv_inertia`), so that the island's matrix is a Gram matrix, symmetric and positive
+    /// semi-definite to f64's rounding. Built in f32 from the rows' angular responses
+    /// I⁻¹·(r × n), whose rounding makes it neither, a 1 kg box under a 10⁶ kg one gave the
+    /// matrix an eigenvalue of −1.0·10⁻⁷ beside the heavy box's own, about 10⁻⁶: its
+    /// contributions are the size of the f32 rounding of the light box's.
+    fn coupling(&self, other: &Row, inv_inertia: &impl Fn(u32) -> Mat3) -> f64 {
         let mine = [(self.a, 1.0, self.rn_a), (self.b, -1.0, self.rn_b)];
         let theirs = [
-            (other.a, 1.0, other.ang_a, other.inv_mass_a),
-            (other.b, -1.0, other.ang_b, other.inv_mass_b),
+            (other.a, 1.0, other.rn_a, other.inv_mass_a),
+            (other.b, -1.0, other.rn_b, other.inv_mass_b),
         ];
+        let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
         let mut sum = 0.0f64;
         for (body, sign, rn) in mine {
             if body == STATIC_BODY {
                 continue;
             }
-            for &(other_body, other_sign, ang, inv_mass) in &theirs {
-                if other_body == body {
-                    let k = inv_mass * self.normal.dot(other.normal) + rn.dot(ang);
-                    sum += f64::from(sign * other_sign * k);
+            for &(other_body, other_sign, other_rn, inv_mass) in &theirs {
+                if other_body != body {
+                    continue;
                 }
+                let m = inv_inertia(body);
+                let cols = [wide(m.x_axis), wide(m.y_axis), wide(m.z_axis)];
+                // I⁻¹ symmetric: (I⁻¹)ᵢⱼ as the mean of its two stored entries.
+                let entry = |i: usize, j: usize| 0.5 * (cols[j][i] + cols[i][j]);
+                let (u, v) = (wide(rn), wide(other_rn));
+                // uᵀ·I⁻¹·v summed so that swapping u and v changes no bit.
+                let cross = |i: usize, j: usize| entry(i, j) * (u[i] * v[j] + u[j] * v[i]);
+                let angular = entry(0, 0) * (u[0] * v[0])
+                    + entry(1, 1) * (u[1] * v[1])
+                    + entry(2, 2) * (u[2] * v[2])
+                    + cross(0, 1)
+                    + cross(0, 2)
+                    + cross(1, 2);
+                let linear = f64::from(inv_mass) * dot(wide(self.normal), wide(other.normal));
+                sum += sign * other_sign * (linear + angular);
             }
         }
         sum
@@ -139,6 +162,9 @@ pub struct DirectIslands {
     row_count: Vec<u32>,
     mixed: Vec<bool>,
     island_of: Vec<u32>,
+    /// The world inverse inertia of each body with rows in an island (by body index; zero
+    /// elsewhere), as the rows' angular responses were prepared.
+    inv_inertia: Vec<Mat3>,
     solver: Solver,
 }
 
@@ -164,6 +190,18 @@ struct Solver {
     change: Vec<f64>,
     /// The free rows, in order.
     index: Vec<usize>,
+    /// The impulses of a solution summed per body ([`Solver::apply`]).
+    sums: Vec<BodySum>,
+}
+
+/// The linear and angular impulse (about the centre of mass) a solution gives one body, in
+/// f64.
+#[derive(Clone, Copy, Debug)]
+struct BodySum {
+    body: u32,
+    inv_mass: f64,
+    linear: [f64; 3],
+    angular: [f64; 3],
 }
 
 /// A row's part in an island's solve.
@@ -190,11 +228,13 @@ impl DirectIslands {
     /// Finds this step's direct islands in the packed `batches`: bodies joined by manifolds
     /// between two movable bodies, kept when they have at most `max_rows` normal rows and
     /// some manifold joins two movable bodies whose inverse masses differ by `mass_ratio` or
-    /// more. Deterministic: islands and rows in the batches' order.
+    /// more. Deterministic: islands and rows in the batches' order. `bodies` are the solver
+    /// bodies `states` were loaded from (their world inverse inertia builds the couplings).
     pub fn build(
         &mut self,
         batches: &Batches,
         states: &[BodyState],
+        bodies: &[SolverBody],
         max_rows: u32,
         mass_ratio: f32,
     ) {
@@ -257,12 +297,12 @@ impl DirectIslands {
                     let p = &batches.points[k as usize];
                     let (r_a, r_b) = (p.r_a.lane(l), p.r_b.lane(l));
                     let rows = [
-                        (NORMAL, p.normal, p.ang_a_normal, p.ang_b_normal),
-                        (TANGENT_1, p.tangent1, p.ang_a_tangent1, p.ang_b_tangent1),
-                        (TANGENT_2, p.tangent2, p.ang_a_tangent2, p.ang_b_tangent2),
+                        (NORMAL, p.normal),
+                        (TANGENT_1, p.tangent1),
+                        (TANGENT_2, p.tangent2),
                     ];
                     let kinds = if p.friction[l] > 0.0 { 3 } else { 1 };
-                    for (kind, d, ang_a, ang_b) in rows.into_iter().take(kinds) {
+                    for (kind, d) in rows.into_iter().take(kinds) {
                         let d = d.lane(l);
                         self.rows.push(Row {
                             island: self.island_of[r],
@@ -278,8 +318,6 @@ impl DirectIslands {
                             normal: d,
                             rn_a: r_a.cross(d),
                             rn_b: r_b.cross(d),
-                            ang_a: ang_a.lane(l),
-                            ang_b: ang_b.lane(l),
                         });
                     }
                 }
@@ -295,10 +333,29 @@ impl DirectIslands {
             }
         }
         self.couplings.clear();
+        // As the rows' angular responses were prepared ([`super::prepare`]).
+        let inv_inertia = |k: u32| {
+            bodies
+                .get(k as usize)
+                .filter(|b| b.rotates())
+                .map_or(Mat3::ZERO, |b| b.inv_inertia)
+        };
+        self.inv_inertia.clear();
+        if !self.islands.is_empty() {
+            self.inv_inertia.resize(states.len(), Mat3::ZERO);
+            for row in &self.rows {
+                for k in [row.a, row.b] {
+                    if let Some(m) = self.inv_inertia.get_mut(k as usize) {
+                        *m = inv_inertia(k);
+                    }
+                }
+            }
+        }
         for &(start, end) in &self.islands {
             let rows = &self.rows[start as usize..end as usize];
             for a in rows {
-                self.couplings.extend(rows.iter().map(|b| a.coupling(b)));
+                self.couplings
+                    .extend(rows.iter().map(|b| a.coupling(b, &inv_inertia)));
             }
         }
         self.factors
@@ -375,8 +432,13 @@ impl DirectIslands {
             let couplings = &self.couplings[offset..offset + rows.len() * rows.len()];
             offset += rows.len() * rows.len();
             let factor = &mut self.factors[island][kind];
+            let island = Island {
+                rows,
+                couplings,
+                inv_inertia: &self.inv_inertia,
+            };
             self.solver
-                .solve_island(manifolds, points, states, rows, couplings, factor, pass);
+                .solve_island(manifolds, points, states, island, factor, pass);
         }
     }
 }
@@ -389,17 +451,20 @@ impl Solver {
     /// point whose friction would leave its disk has it fixed on the disk, and the rest is
     /// solved again, for at most [`ACTIVE_SET_ROUNDS`] rounds; an island whose rounds run out
     /// is left to Gauss-Seidel.
-    #[allow(clippy::too_many_arguments)]
     fn solve_island(
         &mut self,
         manifolds: &[ManifoldLanes],
         points: &mut [PointLanes],
         states: &mut [BodyState],
-        rows: &[Row],
-        couplings: &[f64],
+        island: Island,
         factor: &mut Factor,
         pass: RowPass,
     ) {
+        let Island {
+            rows,
+            couplings,
+            inv_inertia,
+        } = island;
         let relax = matches!(pass, RowPass::Relax { .. });
         self.residual.clear();
         self.impulse.clear();
@@ -456,7 +521,7 @@ impl Solver {
                 if relax && self.energy_change(rows, couplings, states) > 0.0 {
                     return;
                 }
-                self.apply(rows, points, states);
+                self.apply(rows, points, states, inv_inertia);
                 return;
             }
         }
@@ -579,7 +644,19 @@ impl Solver {
 
     /// Applies the changes of the free and fixed rows to the accumulated impulses and to the
     /// bodies.
-    fn apply(&self, rows: &[Row], points: &mut [PointLanes], states: &mut [BodyState]) {
+    fn apply(
+        &mut self,
+        rows: &[Row],
+        points: &mut [PointLanes],
+        states: &mut [BodyState],
+        inv_inertia: &[Mat3],
+    ) {
+        // Each body's impulse is summed in f64 and applied once, through the inverse inertia
+        // the couplings were built with: applied row by row in f32, a light box between a
+        // heavy one and the ground kept the rounding of each face's 10⁴ N·s (velocity noise of
+        // 0.004 m/s and 0.02 rad/s for a 0.1 m box of 1 kg under 10⁶ kg), which rocked the
+        // heavy box off it.
+        self.sums.clear();
         for (i, row) in rows.iter().enumerate() {
             if self.role[i] == Role::Out {
                 continue;
@@ -604,9 +681,65 @@ impl Solver {
             if row.kind == NORMAL {
                 p.max_normal_impulse[l] = p.max_normal_impulse[l].max(delta);
             }
-            row.apply(states, delta);
+            let delta = f64::from(delta);
+            for (body, sign, rn, inv_mass) in [
+                (row.a, 1.0, row.rn_a, row.inv_mass_a),
+                (row.b, -1.0, row.rn_b, row.inv_mass_b),
+            ] {
+                if body == STATIC_BODY {
+                    continue;
+                }
+                let at = match self.sums.iter().position(|s| s.body == body) {
+                    Some(at) => at,
+                    None => {
+                        self.sums.push(BodySum {
+                            body,
+                            inv_mass: f64::from(inv_mass),
+                            linear: [0.0; 3],
+                            angular: [0.0; 3],
+                        });
+                        self.sums.len() - 1
+                    }
+                };
+                let sum = &mut self.sums[at];
+                let (n, rn) = (wide(row.normal), wide(rn));
+                for k in 0..3 {
+                    sum.linear[k] += sign * n[k] * delta;
+                    sum.angular[k] += sign * rn[k] * delta;
+                }
+            }
+        }
+        for sum in &self.sums {
+            let state = &mut states[sum.body as usize];
+            let m = inv_inertia
+                .get(sum.body as usize)
+                .copied()
+                .unwrap_or(Mat3::ZERO);
+            let cols = [wide(m.x_axis), wide(m.y_axis), wide(m.z_axis)];
+            let l = sum.linear.map(|x| (x * sum.inv_mass) as f32);
+            let a: [f32; 3] = std::array::from_fn(|i| {
+                (0..3)
+                    .map(|k| 0.5 * (cols[k][i] + cols[i][k]) * sum.angular[k])
+                    .sum::<f64>() as f32
+            });
+            state.linear_velocity += Vec3::from_array(l);
+            state.angular_velocity += Vec3::from_array(a);
         }
     }
+}
+
+/// One island's rows, their couplings, and the bodies' inverse inertia
+/// ([`DirectIslands::inv_inertia`]).
+#[derive(Clone, Copy)]
+struct Island<'a> {
+    rows: &'a [Row],
+    couplings: &'a [f64],
+    inv_inertia: &'a [Mat3],
+}
+
+/// A vector in f64.
+fn wide(v: Vec3) -> [f64; 3] {
+    [f64::from(v.x), f64::from(v.y), f64::from(v.z)]
 }
 
 impl Row {
@@ -615,21 +748,6 @@ impl Row {
         let (a, b) = (&states[self.a as usize], &states[self.b as usize]);
         self.normal.dot(a.linear_velocity - b.linear_velocity) + self.rn_a.dot(a.angular_velocity)
             - self.rn_b.dot(b.angular_velocity)
-    }
-
-    /// Applies the impulse `delta` along the row (on A, opposite on B).
-    fn apply(&self, states: &mut [BodyState], delta: f32) {
-        let impulse = self.normal * delta;
-        if self.a != STATIC_BODY {
-            let s = &mut states[self.a as usize];
-            s.linear_velocity += impulse * self.inv_mass_a;
-            s.angular_velocity += self.ang_a * delta;
-        }
-        if self.b != STATIC_BODY {
-            let s = &mut states[self.b as usize];
-            s.linear_velocity -= impulse * self.inv_mass_b;
-            s.angular_velocity -= self.ang_b * delta;
-        }
     }
 }
 
@@ -729,6 +847,103 @@ mod tests {
             (b[0] - x[0]).abs() < 1e-9 && (b[1] - x[1]).abs() < 1e-9,
             "{b:?}"
         );
+    }
+
+    #[test]
+    fn couplings_are_the_gram_matrix_of_the_rows_in_f64() {
+        // A light box between the ground and a 10⁶ times heavier box, turned so that no arm
+        // or inertia entry is exact in f32: the couplings must be J·M⁻¹·Jᵀ computed in f64
+        // from the rows' f32 data, symmetric to the last bit (the heavy box's part, 10⁻⁶ of the
+        // light box's, is lost in f32 rounding otherwise).
+        let turn =
+            jostle_math::Quat::from_rotation_y(0.3) * jostle_math::Quat::from_rotation_x(0.01);
+        let inertia = |scale: f32| {
+            let m = Mat3::from_quat(turn);
+            m * Mat3::from_diagonal(Vec3::new(6.0, 5.0, 7.0) * scale) * m.transpose()
+        };
+        let (light_inertia, heavy_inertia) = (inertia(1.0), inertia(1e-6));
+        let inv_inertia = |k: u32| match k {
+            1 => light_inertia,
+            2 => heavy_inertia,
+            _ => Mat3::ZERO,
+        };
+        let up = turn * Vec3::Y;
+        let side = turn * Vec3::X;
+        let row = |a: u32, b: u32, normal: Vec3, arm_a: Vec3, arm_b: Vec3| Row {
+            island: 0,
+            order: 0,
+            kind: NORMAL,
+            batch: 0,
+            point: 0,
+            lane: 0,
+            a,
+            b,
+            inv_mass_a: if a == 2 { 1e-6 } else { 1.0 },
+            inv_mass_b: if b == 2 {
+                1e-6
+            } else if b == 1 {
+                1.0
+            } else {
+                0.0
+            },
+            normal,
+            rn_a: arm_a.cross(normal),
+            rn_b: arm_b.cross(normal),
+        };
+        let corner = |x: f32, y: f32, z: f32| turn * Vec3::new(x, y, z) * 0.5;
+        let rows = [
+            row(1, STATIC_BODY, up, corner(1.0, -1.0, 1.0), Vec3::ZERO),
+            row(1, STATIC_BODY, side, corner(-1.0, -1.0, 1.0), Vec3::ZERO),
+            row(2, 1, up, corner(1.0, -1.0, -1.0), corner(1.0, 1.0, -1.0)),
+            row(
+                2,
+                1,
+                side,
+                corner(-1.0, -1.0, -1.0),
+                corner(-1.0, 1.0, -1.0),
+            ),
+        ];
+        // J as 12-vectors (light's six, heavy's six), M⁻¹ in f64.
+        let wide = |v: Vec3| [f64::from(v.x), f64::from(v.y), f64::from(v.z)];
+        let jacobian = |r: &Row| {
+            let mut j = [0.0f64; 12];
+            for (body, sign, rn) in [(r.a, 1.0, r.rn_a), (r.b, -1.0, r.rn_b)] {
+                if body == STATIC_BODY {
+                    continue;
+                }
+                let at = if body == 1 { 0 } else { 6 };
+                for i in 0..3 {
+                    j[at + i] = sign * wide(r.normal)[i];
+                    j[at + 3 + i] = sign * wide(rn)[i];
+                }
+            }
+            j
+        };
+        let apply_inverse_mass = |j: [f64; 12]| {
+            let mut out = [0.0f64; 12];
+            for (at, inv_mass, m) in [(0, 1.0f64, light_inertia), (6, 1e-6f64, heavy_inertia)] {
+                let cols = [wide(m.x_axis), wide(m.y_axis), wide(m.z_axis)];
+                for i in 0..3 {
+                    out[at + i] = inv_mass * j[at + i];
+                    out[at + 3 + i] = (0..3)
+                        .map(|k| 0.5 * (cols[k][i] + cols[i][k]) * j[at + 3 + k])
+                        .sum::<f64>();
+                }
+            }
+            out
+        };
+        for ri in &rows {
+            for rj in &rows {
+                let (ji, jj) = (jacobian(ri), apply_inverse_mass(jacobian(rj)));
+                let reference: f64 = ji.iter().zip(&jj).map(|(a, b)| a * b).sum();
+                let k = ri.coupling(rj, &inv_inertia);
+                assert_eq!(k.to_bits(), rj.coupling(ri, &inv_inertia).to_bits());
+                assert!(
+                    (k - reference).abs() <= 1e-15 * (1.0 + reference.abs()),
+                    "{k} {reference}"
+                );
+            }
+        }
     }
 
     #[test]

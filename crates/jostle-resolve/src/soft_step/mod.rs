@@ -831,6 +831,7 @@ impl Resolver for SoftStepResolver {
         self.direct.build(
             &self.batches,
             &self.states,
+            bodies,
             direct_rows,
             self.settings.direct_mass_ratio,
         );
