@@ -108,6 +108,10 @@ pub struct BodyDesc {
     /// ([`jostle_body::RigidBody::set_rotation_locks`]). Default: none. `angular_velocity`
     /// must be zero about each locked axis. Ignored for fixed bodies.
     pub rotation_locks: [bool; 3],
+    /// Lock translation along some world axes (x, y, z)
+    /// ([`jostle_body::RigidBody::set_translation_locks`]). Default: none. `linear_velocity`
+    /// must be zero along each locked axis. Ignored for fixed bodies.
+    pub translation_locks: [bool; 3],
     /// Makes the body kinematic: moved by its velocity, to the poses it is sent to, or along
     /// a path; it pushes dynamic bodies and nothing pushes it. `None` (the default): dynamic,
     /// or fixed with `fixed`.
@@ -210,6 +214,7 @@ impl BodyDesc {
             ccd: CcdMode::Auto,
             lock_rotation: false,
             rotation_locks: [false; 3],
+            translation_locks: [false; 3],
             kinematic: None,
             sensor: false,
             groups: CollisionGroups::ALL,
@@ -367,6 +372,18 @@ impl BodyDesc {
             ));
         }
         for (axis, name) in ["x", "y", "z"].iter().enumerate() {
+            if self.translation_locks[axis] && !self.fixed && self.linear_velocity[axis] != 0.0 {
+                return Err(err(
+                    "linear_velocity",
+                    format!(
+                        "must have no {name} component when translation along {name} is \
+                         locked, got {}",
+                        self.linear_velocity
+                    ),
+                ));
+            }
+        }
+        for (axis, name) in ["x", "y", "z"].iter().enumerate() {
             if self.rotation_locks[axis] && !self.fixed && self.angular_velocity[axis] != 0.0 {
                 return Err(err(
                     "angular_velocity",
@@ -441,6 +458,13 @@ impl BodyDesc {
     /// ([`BodyDesc::rotation_locks`]).
     pub fn with_rotation_locks(mut self, locks: [bool; 3]) -> Self {
         self.rotation_locks = locks;
+        self
+    }
+
+    /// With translation along the world axes marked `true` (x, y, z) locked
+    /// ([`BodyDesc::translation_locks`]).
+    pub fn with_translation_locks(mut self, locks: [bool; 3]) -> Self {
+        self.translation_locks = locks;
         self
     }
 

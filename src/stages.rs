@@ -195,6 +195,14 @@ pub(crate) fn gather(
             body.inv_mass(),
             body.inv_inertia_world(),
         );
+        for (axis, bit) in [SolverBody::LOCK_X, SolverBody::LOCK_Y, SolverBody::LOCK_Z]
+            .into_iter()
+            .enumerate()
+        {
+            if body.translation_locks()[axis] {
+                sb.flags |= bit;
+            }
+        }
         // The forces' velocity change goes to the resolver to add over the step, not at once.
         sb.linear_velocity = v0;
         sb.angular_velocity = w0;
@@ -409,7 +417,7 @@ pub(crate) fn ccd(
             let inv_inertia = start.inv_inertia_world_at(at.rotation);
             let (v, w) = impact_velocity(
                 (end.linear_velocity, w),
-                end.inv_mass,
+                end.inv_mass_axes(),
                 inv_inertia,
                 c.point - at.translation,
                 c.normal,
@@ -466,7 +474,8 @@ fn sweep_motion(
 /// one slop short, or deeper when its core was cast from an overlapping start.
 const CCD_CONTACT_REACH: f32 = 4.0;
 
-/// The velocity `(v, ω)` of a body of inverse mass `inv_mass` and world inverse inertia
+/// The velocity `(v, ω)` of a body of inverse mass `inv_mass` (along each world axis: zero
+/// along a locked one) and world inverse inertia
 /// `inv_inertia` after an impact at the lever arm `r` (from its centre of mass) on a fixed
 /// surface of normal `n` (toward the body), with the contact's `material`, as the seed
 /// lecture's contact-space impulse: unchanged unless the point approaches; then the impulse
@@ -478,7 +487,7 @@ const CCD_CONTACT_REACH: f32 = 4.0;
 /// the frictionless one never does for e ≤ 1.
 fn impact_velocity(
     (v, w): (Vec3, Vec3),
-    inv_mass: f32,
+    inv_mass: Vec3,
     inv_inertia: Mat3,
     r: Vec3,
     n: Vec3,
@@ -492,7 +501,7 @@ fn impact_velocity(
     let e = material.restitution.clamp(0.0, 1.0);
     let rx = skew(r);
     // K = m⁻¹·1 − [r]×·I⁻¹·[r]×: the point's velocity change per unit impulse.
-    let k = Mat3::IDENTITY * inv_mass - rx * inv_inertia * rx;
+    let k = Mat3::from_diagonal(inv_mass) - rx * inv_inertia * rx;
     let adds_energy = |j: Vec3| j.dot(vp) + 0.5 * j.dot(k * j) > 0.0;
     let apply = |j: Vec3| (v + j * inv_mass, w + inv_inertia * r.cross(j));
     let usable = |j: Vec3| j.is_finite() && j.dot(n) >= 0.0 && !adds_energy(j);
@@ -600,7 +609,7 @@ pub(crate) fn scatter(
                 + turned_sq * inv_dt * inv_dt;
         body.position = solver.position;
         body.orientation = solver.orientation;
-        body.linear_velocity = solver.linear_velocity;
+        body.linear_velocity = body.without_locked_motion(solver.linear_velocity);
         // (A locked axis gains no turn in the solve but for rounding, which is dropped.)
         body.angular_velocity = body.without_locked_turn(solver.angular_velocity);
         body.last_acceleration = solver.last_acceleration;

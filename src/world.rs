@@ -182,6 +182,9 @@ impl World {
             } else if desc.rotation_locks != [false; 3] {
                 body.set_rotation_locks(desc.rotation_locks);
             }
+            if desc.translation_locks != [false; 3] {
+                body.set_translation_locks(desc.translation_locks);
+            }
             (
                 body,
                 jostle_collide::Pose::from_translation(-props.local_com),
@@ -404,7 +407,8 @@ impl World {
         let world_shift = b.orientation * shift;
         b.position += world_shift;
         b.set_origin_offset(b.origin_offset() - shift);
-        b.linear_velocity += b.angular_velocity.cross(world_shift);
+        b.linear_velocity =
+            b.without_locked_motion(b.linear_velocity + b.angular_velocity.cross(world_shift));
         for c in self.colliders.attached(body) {
             if let Some(collider) = self.colliders.get_mut(c) {
                 let pose = collider.local_pose();
@@ -597,7 +601,7 @@ impl World {
         Self::finite("angular velocity", angular)?;
         Self::within_speed_limits(linear, angular)?;
         let body = self.body_mut_awake(handle)?;
-        body.linear_velocity = linear;
+        body.linear_velocity = body.without_locked_motion(linear);
         if !body.is_rotation_locked() {
             body.angular_velocity = body.without_locked_turn(angular);
         }
@@ -1042,6 +1046,46 @@ impl World {
             )));
         }
         self.body_mut_awake(handle)?.set_rotation_locks(locks);
+        Ok(())
+    }
+
+    /// Locks (or, with `false`, unlocks) a body's translation along each world axis (x, y,
+    /// z) ([`RigidBody::set_translation_locks`]): its linear velocity loses the locked
+    /// components and nothing (contacts, impulses, forces, gravity) moves its centre of mass
+    /// along them any more, in either resolver. Wakes the body. Refused for a fixed body.
+    ///
+    /// ```
+    /// use jostle::{BodyDesc, ShapeDesc, Vec3, World, WorldSettings};
+    ///
+    /// let mut world = World::new(WorldSettings::default());
+    /// let puck = world.add_body(BodyDesc::dynamic("puck", ShapeDesc::Ball { radius: 0.5 })).unwrap();
+    /// // Gravity pulls along y: locked along y, the puck floats where it is.
+    /// world.set_translation_locks(puck, [false, true, false]).unwrap();
+    /// world.apply_impulse_at_point(puck, Vec3::new(3.0, 3.0, 0.0), Vec3::ZERO).unwrap();
+    /// for _ in 0..60 {
+    ///     world.step(1.0 / 60.0).unwrap();
+    /// }
+    /// let b = world.body(puck).unwrap();
+    /// assert_eq!(b.position.y, 0.0);
+    /// assert!(b.position.x > 0.0);
+    /// ```
+    pub fn set_translation_locks(
+        &mut self,
+        handle: BodyHandle,
+        locks: [bool; 3],
+    ) -> Result<(), StepError> {
+        if self
+            .bodies
+            .get(handle)
+            .ok_or(StepError::InvalidHandle(handle))?
+            .is_fixed()
+        {
+            return Err(invalid((
+                "translation_locks",
+                "a fixed body does not move: make it dynamic first".into(),
+            )));
+        }
+        self.body_mut_awake(handle)?.set_translation_locks(locks);
         Ok(())
     }
 

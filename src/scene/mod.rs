@@ -237,6 +237,10 @@ pub struct BodySpec {
     /// about the vertical alone. Default: none.
     #[serde(default)]
     pub rotation_locks: [bool; 3],
+    /// Lock translation along some world axes, `(x, y, z)`: `(false, false, true)` keeps the
+    /// body in its x-y plane. Default: none.
+    #[serde(default)]
+    pub translation_locks: [bool; 3],
     /// Makes the body kinematic (pushes dynamic bodies, pushed by nothing): `Velocity` (moved
     /// by `linear_velocity` and `angular_velocity`), `Position` (moved by the program),
     /// `Line(offset: (x, y, z), period: s)` (back and forth) or `Turn(center: (x, y, z),
@@ -332,6 +336,7 @@ impl BodySpec {
             ccd: self.ccd,
             lock_rotation: self.lock_rotation,
             rotation_locks: self.rotation_locks,
+            translation_locks: self.translation_locks,
             kinematic: self.kinematic,
             sensor: self.sensor,
             groups: self.groups,

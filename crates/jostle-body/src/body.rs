@@ -141,6 +141,10 @@ pub struct RigidBody {
     /// Rotation about each world axis (x, y, z) locked ([`RigidBody::set_rotation_locks`]).
     #[cfg_attr(feature = "serde", serde(default))]
     rotation_locks: [bool; 3],
+    /// Translation along each world axis (x, y, z) locked
+    /// ([`RigidBody::set_translation_locks`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    translation_locks: [bool; 3],
 }
 
 #[cfg(feature = "serde")]
@@ -372,6 +376,7 @@ impl RigidBody {
             gravity_scale: 1.0,
             origin_offset: Vec3::ZERO,
             rotation_locks: [false; 3],
+            translation_locks: [false; 3],
         }
     }
 
@@ -543,6 +548,36 @@ impl RigidBody {
         }
     }
 
+    /// Locks translation along some world axes (x, y, z): the body's inverse mass along them
+    /// is zero, so no contact, impulse, force or gravity moves its centre of mass along them,
+    /// and its linear velocity loses its components along them (a body locked along z moves
+    /// in its x-y plane only: a 2D game's body, with [`RigidBody::set_rotation_locks`] about x
+    /// and y). The mass is kept; `[false; 3]` unlocks.
+    pub fn set_translation_locks(&mut self, locks: [bool; 3]) {
+        self.translation_locks = locks;
+        self.linear_velocity = self.without_locked_motion(self.linear_velocity);
+    }
+
+    /// Which world axes' translation is locked ([`RigidBody::set_translation_locks`]).
+    pub fn translation_locks(&self) -> [bool; 3] {
+        self.translation_locks
+    }
+
+    /// `v` without its components along world axes the body's translation is locked on.
+    #[inline]
+    pub fn without_locked_motion(&self, v: Vec3) -> Vec3 {
+        if self.translation_locks == [false; 3] {
+            v
+        } else {
+            let free = |locked: bool| if locked { 0.0 } else { 1.0 };
+            v * Vec3::new(
+                free(self.translation_locks[0]),
+                free(self.translation_locks[1]),
+                free(self.translation_locks[2]),
+            )
+        }
+    }
+
     /// Checks a body that did not come from [`RigidBody::dynamic`] or [`RigidBody::fixed`] (a
     /// snapshot read back): every number finite and in its domain, a unit orientation, mass
     /// and inverse mass that agree, a fixed body with no inverse mass or inertia, and
@@ -689,9 +724,10 @@ impl RigidBody {
     }
 
     /// Applies an impulse (N·s) at world point `point` now: Δv = J/m, Δω = I⁻¹·(r × J).
-    /// No effect on a fixed body.
+    /// No effect on a fixed body, none along locked axes
+    /// ([`RigidBody::set_translation_locks`], [`RigidBody::set_rotation_locks`]).
     pub fn apply_impulse_at_point(&mut self, impulse: Vec3, point: Vec3) {
-        self.linear_velocity += impulse * self.inv_mass;
+        self.linear_velocity += self.without_locked_motion(impulse * self.inv_mass);
         self.angular_velocity += self.inv_inertia_world * (point - self.position).cross(impulse);
     }
 

@@ -9,14 +9,16 @@ use jostle_math::{Vec3, integrate_orientation};
 /// Adds gravity and the step's applied forces ([`SolverBody::force_velocity`],
 /// [`SolverBody::torque_velocity`], which are then cleared) to the velocity of every movable
 /// body (index 0, the static entry, is skipped) and records gravity as the body's
-/// `last_acceleration`.
+/// `last_acceleration`. Neither acts along an axis the body's translation is locked on
+/// ([`SolverBody::LOCK_X`]).
 pub fn integrate_velocities(bodies: &mut [SolverBody], gravity: Vec3, dt: f32) {
     for body in bodies.iter_mut().skip(STATIC_BODY as usize + 1) {
-        body.linear_velocity += std::mem::take(&mut body.force_velocity);
+        let free = body.linear_freedom();
+        body.linear_velocity += std::mem::take(&mut body.force_velocity) * free;
         body.angular_velocity += std::mem::take(&mut body.torque_velocity);
         if body.inv_mass > 0.0 {
-            body.linear_velocity += gravity * dt;
-            body.last_acceleration = gravity;
+            body.linear_velocity += gravity * free * dt;
+            body.last_acceleration = gravity * free;
         } else {
             body.last_acceleration = Vec3::ZERO;
         }

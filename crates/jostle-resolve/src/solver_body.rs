@@ -26,7 +26,7 @@ pub struct SolverBody {
     pub inv_mass: f32,
     /// Linear velocity of the centre of mass (m/s).
     pub linear_velocity: Vec3,
-    /// Flags, see [`SolverBody::ROTATES`].
+    /// Flags, see [`SolverBody::ROTATES`] and [`SolverBody::LOCK_X`].
     pub flags: u32,
     /// Angular velocity (rad/s), world space.
     pub angular_velocity: Vec3,
@@ -56,6 +56,16 @@ impl SolverBody {
     /// Flag: the body's inverse inertia is non-zero, so resolvers do angular work for it.
     /// Clear it to skip every angular term of a body that cannot rotate.
     pub const ROTATES: u32 = 1;
+    /// Flag: the body cannot move along world x (its translation is locked on that axis):
+    /// its inverse mass along x is zero ([`SolverBody::inv_mass_axes`]), and gravity and
+    /// forces do not act along x. [`SolverBody::LOCK_Y`] and [`SolverBody::LOCK_Z`] likewise.
+    pub const LOCK_X: u32 = 2;
+    /// Flag: translation along world y locked (see [`SolverBody::LOCK_X`]).
+    pub const LOCK_Y: u32 = 4;
+    /// Flag: translation along world z locked (see [`SolverBody::LOCK_X`]).
+    pub const LOCK_Z: u32 = 8;
+    /// All three translation-lock flags.
+    pub const LOCKS: u32 = Self::LOCK_X | Self::LOCK_Y | Self::LOCK_Z;
 
     /// The shared static entry: immovable, at rest, never written.
     pub const STATIC: SolverBody = SolverBody {
@@ -93,6 +103,49 @@ impl SolverBody {
     #[inline]
     pub fn rotates(&self) -> bool {
         self.flags & Self::ROTATES != 0
+    }
+
+    /// 1 along each world axis the body may move along, 0 along a locked one
+    /// ([`SolverBody::LOCK_X`]).
+    #[inline]
+    pub fn linear_freedom(&self) -> Vec3 {
+        if self.flags & Self::LOCKS == 0 {
+            return Vec3::ONE;
+        }
+        let free = |bit: u32| if self.flags & bit == 0 { 1.0 } else { 0.0 };
+        Vec3::new(free(Self::LOCK_X), free(Self::LOCK_Y), free(Self::LOCK_Z))
+    }
+
+    /// The inverse mass along each world axis (1/kg): [`SolverBody::inv_mass`], zero along a
+    /// locked axis. An impulse J changes the velocity by `inv_mass_axes() * J`, component by
+    /// component.
+    #[inline]
+    pub fn inv_mass_axes(&self) -> Vec3 {
+        self.linear_freedom() * self.inv_mass
+    }
+
+    /// The inverse mass the body shows to an impulse along the unit vector `n` (1/kg):
+    /// n·(M⁻¹·n), [`SolverBody::inv_mass`] without translation locks.
+    #[inline]
+    pub fn inv_mass_along(&self, n: Vec3) -> f32 {
+        if self.flags & Self::LOCKS == 0 {
+            self.inv_mass
+        } else {
+            n.dot(self.inv_mass_axes() * n)
+        }
+    }
+
+    /// The direction the centre of mass moves in when the body is pushed along the unit
+    /// vector `n`, scaled to advance 1 along `n`: M⁻¹·n / (n·M⁻¹·n); `n` itself without
+    /// translation locks, zero when the body cannot move along `n` at all.
+    #[inline]
+    pub fn linear_direction(&self, n: Vec3) -> Vec3 {
+        if self.flags & Self::LOCKS == 0 {
+            return n;
+        }
+        let along = self.inv_mass_axes() * n;
+        let k = n.dot(along);
+        if k > 0.0 { along / k } else { Vec3::ZERO }
     }
 
     /// Whether the body can move at all (non-zero inverse mass or inverse inertia).

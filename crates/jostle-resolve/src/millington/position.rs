@@ -17,7 +17,9 @@ use jostle_math::{Mat3, Vec3, integrate_orientation};
 /// penetration.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PenetrationMoves {
-    /// Linear move of each side's centre of mass along the normal (m).
+    /// Linear move of each side's centre of mass along the normal (m; a body with a
+    /// translation lock moves as [`SolverBody::linear_direction`] says, by this much along
+    /// the normal).
     pub linear: [f32; 2],
     /// Move of each side's contact point along the normal produced by rotation (m).
     pub angular: [f32; 2],
@@ -45,7 +47,7 @@ pub fn nonlinear_moves(
     let mut total = 0.0f32;
     for side in 0..2 {
         if let Some(b) = p.side_body(bodies, side) {
-            lin[side] = b.inv_mass;
+            lin[side] = b.inv_mass_along(n);
             ang[side] = angular_inertia(b, p.r[side], n);
             total += lin[side] + ang[side];
         }
@@ -93,11 +95,12 @@ pub fn linear_moves(
         return None;
     }
     let depth = p.penetration * relaxation;
+    let n = p.normal();
     let mut moves = PenetrationMoves::default();
     for side in 0..2 {
         if let Some(b) = p.side_body(bodies, side) {
             let sign = if side == 0 { 1.0 } else { -1.0 };
-            moves.linear[side] = sign * depth * (b.inv_mass / total);
+            moves.linear[side] = sign * depth * (b.inv_mass_along(n) / total);
         }
     }
     Some(moves)
@@ -127,7 +130,9 @@ pub fn apply_moves(
             change.body[side] = NO_BODY;
             continue;
         };
-        let linear = n * moves.linear[side];
+        // Along n, or as near it as a translation lock allows, advancing `moves.linear`
+        // along n all the same.
+        let linear = b.linear_direction(n) * moves.linear[side];
         b.position += linear;
         change.linear[side] = linear;
         let rotation = moves.rotation[side];

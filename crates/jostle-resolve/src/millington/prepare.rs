@@ -277,8 +277,9 @@ pub fn prepare(
     let mut linear_inertia = 0.0;
     for (side, b) in [body_a, body_b].into_iter().enumerate() {
         if body[side] != NO_BODY {
-            linear_inertia += b.inv_mass;
-            normal_inertia += b.inv_mass + angular_inertia(b, r[side], n);
+            let along = b.inv_mass_along(n);
+            linear_inertia += along;
+            normal_inertia += along + angular_inertia(b, r[side], n);
         }
     }
 

@@ -42,15 +42,24 @@ pub fn velocity_change_per_unit_impulse(p: &PreparedContact) -> f32 {
 pub fn impulse_matrix(p: &PreparedContact, bodies: &[SolverBody]) -> Mat3 {
     let mut angular = Mat3::ZERO;
     let mut inv_mass = 0.0;
+    let mut locked = Mat3::ZERO;
     for side in 0..2 {
         let Some(b) = p.side_body(bodies, side) else {
             continue;
         };
-        inv_mass += b.inv_mass;
+        if b.flags & SolverBody::LOCKS == 0 {
+            inv_mass += b.inv_mass;
+        } else {
+            // A translation lock: M⁻¹ is diagonal, zero along the locked world axes.
+            locked += Mat3::from_diagonal(b.inv_mass_axes());
+        }
         if b.rotates() {
             let to_torque = skew(p.r[side]);
             angular -= to_torque * b.inv_inertia * to_torque;
         }
+    }
+    if locked != Mat3::ZERO {
+        angular += locked;
     }
     let mut k = p.basis.transpose() * angular * p.basis;
     k.x_axis.x += inv_mass;
@@ -343,7 +352,7 @@ pub fn apply_impulse(p: &PreparedContact, g: Vec3, bodies: &mut [SolverBody]) ->
             continue;
         };
         let j = if side == 0 { world } else { -world };
-        let dv = j * b.inv_mass;
+        let dv = j * b.inv_mass_axes();
         b.linear_velocity += dv;
         change.linear[side] = dv;
         if b.rotates() {

@@ -120,16 +120,21 @@ pub struct ManifoldLanes<F = F8> {
     pub a: [u32; LANES],
     /// Solver index of body B per lane.
     pub b: [u32; LANES],
-    /// 1/m of A per lane (1/kg).
-    pub inv_mass_a: F,
-    /// 1/m of B per lane (1/kg).
-    pub inv_mass_b: F,
+    /// 1/m of A per lane along each world axis (1/kg; zero along a locked axis:
+    /// [`crate::SolverBody::inv_mass_axes`]).
+    pub inv_mass_a: V3x8<F>,
+    /// 1/m of B per lane along each world axis (1/kg).
+    pub inv_mass_b: V3x8<F>,
     /// Index of the first [`PointLanes`] of this batch.
     pub first: u32,
     /// Number of [`PointLanes`]: the most points of any lane.
     pub count: u32,
     /// Whether any point of any lane has friction (μ > 0): otherwise friction is skipped.
     pub friction: bool,
+    /// Whether the body of some lane has a translation lock (its inverse mass differs
+    /// between axes): the kernels then apply impulses through [`ManifoldLanes::inv_mass_a`]
+    /// axis by axis, otherwise through its x component alone.
+    pub locked: bool,
     /// The Cholesky factor L of the batch's block system K + ε·diag(K) over its points
     /// ([`super::solve::factor_blocks`], for the block relax): L's entries below the
     /// diagonal row by row (l₁₀, l₂₀, l₂₁, l₃₀, l₃₁, l₃₂), then 1/lᵢᵢ for i = 0..4.
@@ -419,11 +424,12 @@ impl Batches {
         self.manifolds.push(ManifoldLanes {
             a,
             b,
-            inv_mass_a: F8::ZERO,
-            inv_mass_b: F8::ZERO,
+            inv_mass_a: V3x8::ZERO,
+            inv_mass_b: V3x8::ZERO,
             first,
             count,
             friction,
+            locked: false,
             block: [F8::ZERO; BLOCK_ENTRIES],
         });
     }

@@ -73,6 +73,21 @@ impl BodyState {
         }
     }
 
+    /// 1 along each world axis the body may move along, 0 along a locked one
+    /// ([`SolverBody::LOCK_X`]; the flags are the solver body's).
+    #[inline(always)]
+    pub fn linear_freedom(&self) -> Vec3 {
+        if self.flags & SolverBody::LOCKS == 0 {
+            return Vec3::ONE;
+        }
+        let free = |bit: u32| if self.flags & bit == 0 { 1.0 } else { 0.0 };
+        Vec3::new(
+            free(SolverBody::LOCK_X),
+            free(SolverBody::LOCK_Y),
+            free(SolverBody::LOCK_Z),
+        )
+    }
+
     /// The first eight floats: linear velocity, 1/m, angular velocity, and the flags' bits.
     #[inline(always)]
     pub fn velocity_row(&self) -> &[f32; 8] {

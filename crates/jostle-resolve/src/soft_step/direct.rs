@@ -83,8 +83,9 @@ struct Row {
     lane: u8,
     a: u32,
     b: u32,
-    inv_mass_a: f32,
-    inv_mass_b: f32,
+    /// 1/m of A and B along each world axis (zero along a locked axis).
+    inv_mass_a: Vec3,
+    inv_mass_b: Vec3,
     /// The row's direction d: the normal or a tangent.
     normal: Vec3,
     /// r_A × d and r_B × d.
@@ -136,7 +137,14 @@ impl Row {
                     + cross(0, 1)
                     + cross(0, 2)
                     + cross(1, 2);
-                let linear = f64::from(inv_mass) * dot(wide(self.normal), wide(other.normal));
+                let (n, m) = (wide(self.normal), wide(other.normal));
+                let linear = if inv_mass.x == inv_mass.y && inv_mass.y == inv_mass.z {
+                    f64::from(inv_mass.x) * dot(n, m)
+                } else {
+                    // A translation lock: M⁻¹ diagonal.
+                    let w = wide(inv_mass);
+                    w[0] * n[0] * m[0] + w[1] * n[1] * m[1] + w[2] * n[2] * m[2]
+                };
                 sum += sign * other_sign * (linear + angular);
             }
         }
@@ -199,7 +207,8 @@ struct Solver {
 #[derive(Clone, Copy, Debug)]
 struct BodySum {
     body: u32,
-    inv_mass: f64,
+    /// 1/m along each world axis.
+    inv_mass: [f64; 3],
     linear: [f64; 3],
     angular: [f64; 3],
 }
@@ -268,7 +277,8 @@ impl DirectIslands {
                 };
                 let rows = points.iter().filter(|s| s[l] != NO_SOURCE).count() as u32;
                 self.row_count[root as usize] += rows;
-                let (ia, ib) = (m.inv_mass_a[l], m.inv_mass_b[l]);
+                let mass = |i: u32| states[i as usize].inv_mass;
+                let (ia, ib) = (mass(m.a[l]), mass(m.b[l]));
                 if movable(m.a[l]) && movable(m.b[l]) && ia.max(ib) >= mass_ratio * ia.min(ib) {
                     self.mixed[root as usize] = true;
                 }
@@ -313,8 +323,8 @@ impl DirectIslands {
                             lane: l as u8,
                             a: m.a[l],
                             b: m.b[l],
-                            inv_mass_a: m.inv_mass_a[l],
-                            inv_mass_b: m.inv_mass_b[l],
+                            inv_mass_a: m.inv_mass_a.lane(l),
+                            inv_mass_b: m.inv_mass_b.lane(l),
                             normal: d,
                             rn_a: r_a.cross(d),
                             rn_b: r_b.cross(d),
@@ -694,7 +704,7 @@ impl Solver {
                     None => {
                         self.sums.push(BodySum {
                             body,
-                            inv_mass: f64::from(inv_mass),
+                            inv_mass: wide(inv_mass),
                             linear: [0.0; 3],
                             angular: [0.0; 3],
                         });
@@ -716,7 +726,7 @@ impl Solver {
                 .copied()
                 .unwrap_or(Mat3::ZERO);
             let cols = [wide(m.x_axis), wide(m.y_axis), wide(m.z_axis)];
-            let l = sum.linear.map(|x| (x * sum.inv_mass) as f32);
+            let l: [f32; 3] = std::array::from_fn(|i| (sum.linear[i] * sum.inv_mass[i]) as f32);
             let a: [f32; 3] = std::array::from_fn(|i| {
                 (0..3)
                     .map(|k| 0.5 * (cols[k][i] + cols[i][k]) * sum.angular[k])
@@ -878,14 +888,14 @@ mod tests {
             lane: 0,
             a,
             b,
-            inv_mass_a: if a == 2 { 1e-6 } else { 1.0 },
-            inv_mass_b: if b == 2 {
+            inv_mass_a: Vec3::splat(if a == 2 { 1e-6 } else { 1.0 }),
+            inv_mass_b: Vec3::splat(if b == 2 {
                 1e-6
             } else if b == 1 {
                 1.0
             } else {
                 0.0
-            },
+            }),
             normal,
             rn_a: arm_a.cross(normal),
             rn_b: arm_b.cross(normal),

@@ -8,6 +8,7 @@
 
 use super::body_state::{BodyState, FREE, PseudoRow};
 use super::gyroscopic::turn_against;
+use crate::SolverBody;
 use jostle_math::{Mat3, Quat, Vec3, integrate_orientation};
 
 /// v ← v + g·h for every body of `states` with mass, and each body's share of its applied
@@ -18,7 +19,12 @@ pub fn integrate_velocities(states: &mut [BodyState], pushes: &[[Vec3; 2]], grav
     let dv = gravity * h;
     for s in states.iter_mut() {
         if s.inv_mass > 0.0 && s.flags & FREE == 0 {
-            s.linear_velocity += dv;
+            // Not along a locked axis (a rare flag: one test of the common case).
+            s.linear_velocity += if s.flags & SolverBody::LOCKS == 0 {
+                dv
+            } else {
+                dv * s.linear_freedom()
+            };
         }
     }
     for (s, [linear, angular]) in states.iter_mut().zip(pushes) {
@@ -99,7 +105,11 @@ pub fn integrate_free(states: &mut [BodyState], gravity: Vec3, h: f32, substeps:
     let n = substeps as f32;
     let dv = gravity * h;
     for s in states.iter_mut().filter(|s| s.flags & FREE != 0) {
-        let g = if s.inv_mass > 0.0 { dv } else { Vec3::ZERO };
+        let g = if s.inv_mass > 0.0 {
+            dv * s.linear_freedom()
+        } else {
+            Vec3::ZERO
+        };
         s.delta_position += (s.linear_velocity * n + g * (n * (n + 1.0) * 0.5)) * h;
         s.linear_velocity += g * n;
         s.flags &= !FREE;
@@ -109,7 +119,6 @@ pub fn integrate_free(states: &mut [BodyState], gravity: Vec3, h: f32, substeps:
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::SolverBody;
 
     /// A free body's substeps at once land where stepping them one by one does.
     #[test]

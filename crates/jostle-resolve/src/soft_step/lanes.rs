@@ -320,6 +320,23 @@ impl<F: Lane> V3x8<F> {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
 
+    /// Component-wise product (a per-axis scale of each lane's vector).
+    #[inline(always)]
+    pub fn scale(self, o: Self) -> Self {
+        Self {
+            x: self.x * o.x,
+            y: self.y * o.y,
+            z: self.z * o.z,
+        }
+    }
+
+    /// The lanes whose three components are equal (an inverse mass the same along every
+    /// axis: no translation lock).
+    #[inline(always)]
+    pub fn uniform(self) -> F::Mask {
+        self.x.cmpeq(self.y) & self.y.cmpeq(self.z)
+    }
+
     /// Lane-wise cross product.
     #[inline(always)]
     pub fn cross(self, o: Self) -> Self {

@@ -278,11 +278,12 @@ impl SoftStepResolver {
             .any(|b| b.force_velocity != zero || b.torque_velocity != zero)
         {
             let share = 1.0 / self.settings.substeps.max(1) as f32;
-            self.pushes.extend(
-                bodies
-                    .iter()
-                    .map(|b| [b.force_velocity * share, b.torque_velocity * share]),
-            );
+            self.pushes.extend(bodies.iter().map(|b| {
+                [
+                    b.force_velocity * b.linear_freedom() * share,
+                    b.torque_velocity * share,
+                ]
+            }));
         }
         self.pseudo.clear();
         self.pseudo.resize(bodies.len(), [0.0; 8]);

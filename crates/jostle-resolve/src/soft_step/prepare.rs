@@ -52,6 +52,8 @@ pub struct BodyLanes<F = F8> {
     inv_inertia: [V3x8<F>; 3],
     /// 1/m (1/kg).
     pub inv_mass: F,
+    /// 1/m along each world axis (1/kg; zero along a locked axis).
+    pub inv_mass_axes: V3x8<F>,
 }
 
 impl<F: Lane> BodyLanes<F> {
@@ -76,6 +78,7 @@ impl<F: Lane> BodyLanes<F> {
                 V3x8::from_lanes(inertia.map(|m| m.z_axis)),
             ],
             inv_mass: F::from_array(b.map(|b| b.inv_mass)),
+            inv_mass_axes: V3x8::from_lanes(b.map(|b| b.inv_mass_axes())),
         }
     }
 
@@ -150,11 +153,20 @@ pub fn prepare_point<F: Lane>(
     let r_a = point - a.position;
     let r_b = point_b - b.position;
     let m = a.inv_mass + b.inv_mass;
+    // Where a body's translation is locked on some axis, its inverse mass is a diagonal
+    // matrix M: the rows' linear parts are u·(M_A + M_B)·v; elsewhere m·(u·v), with u·u
+    // taken as 1 and t₁·t₂ as 0 as before.
+    let m_axes = a.inv_mass_axes + b.inv_mass_axes;
+    let uniform = a.inv_mass_axes.uniform() & b.inv_mass_axes.uniform();
+    let linear = |u: V3x8<F>, v: V3x8<F>, same: bool| {
+        let plain = if same { m } else { F::ZERO };
+        F::select(uniform, plain, m_axes.scale(u).dot(v))
+    };
 
     let (rn_a, rn_b) = (r_a.cross(n), r_b.cross(n));
     let ang_a_normal = a.inv_inertia_times(rn_a);
     let ang_b_normal = b.inv_inertia_times(rn_b);
-    let k_normal = m + rn_a.dot(ang_a_normal) + rn_b.dot(ang_b_normal);
+    let k_normal = linear(n, n, true) + rn_a.dot(ang_a_normal) + rn_b.dot(ang_b_normal);
     let normal_mass = F::select(k_normal.cmpgt(F::ZERO), k_normal.recip(), F::ZERO);
 
     let rt_a = [r_a.cross(t1), r_a.cross(t2)];
@@ -162,9 +174,9 @@ pub fn prepare_point<F: Lane>(
     let ang_a_tangent = [a.inv_inertia_times(rt_a[0]), a.inv_inertia_times(rt_a[1])];
     let ang_b_tangent = [b.inv_inertia_times(rt_b[0]), b.inv_inertia_times(rt_b[1])];
     // K = m·I + Σ (r × tᵢ)·I⁻¹·(r × tⱼ) over both bodies, symmetric.
-    let k11 = m + rt_a[0].dot(ang_a_tangent[0]) + rt_b[0].dot(ang_b_tangent[0]);
-    let k12 = F::ZERO + rt_a[0].dot(ang_a_tangent[1]) + rt_b[0].dot(ang_b_tangent[1]);
-    let k22 = m + rt_a[1].dot(ang_a_tangent[1]) + rt_b[1].dot(ang_b_tangent[1]);
+    let k11 = linear(t1, t1, true) + rt_a[0].dot(ang_a_tangent[0]) + rt_b[0].dot(ang_b_tangent[0]);
+    let k12 = linear(t1, t2, false) + rt_a[0].dot(ang_a_tangent[1]) + rt_b[0].dot(ang_b_tangent[1]);
+    let k22 = linear(t2, t2, true) + rt_a[1].dot(ang_a_tangent[1]) + rt_b[1].dot(ang_b_tangent[1]);
     let det = k11 * k22 - k12 * k12;
     let invertible = det.cmpgt(F::splat(f32::EPSILON) * k11 * k22) & det.is_finite_mask();
     let inv_det = F::select(invertible, det.recip(), F::ZERO);
@@ -267,8 +279,10 @@ fn prepare_batches_impl<F: Lane>(
     for m in manifolds.iter_mut() {
         let a = BodyLanes::<F>::gather(bodies, m.a);
         let b = BodyLanes::<F>::gather(bodies, m.b);
-        m.inv_mass_a = a.inv_mass;
-        m.inv_mass_b = b.inv_mass;
+        m.inv_mass_a = a.inv_mass_axes;
+        m.inv_mass_b = b.inv_mass_axes;
+        let differs = |v: V3x8<F>| (0..WIDTH).any(|l| v.x[l] != v.y[l] || v.y[l] != v.z[l]);
+        m.locked = differs(a.inv_mass_axes) || differs(b.inv_mass_axes);
         let range = m.first as usize..(m.first + m.count) as usize;
         for (out, source) in points[range.clone()].iter_mut().zip(&sources[range]) {
             let lane_contacts = source.map(|i| (i != NO_SOURCE).then(|| &contacts[i as usize]));

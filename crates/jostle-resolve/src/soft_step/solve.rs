@@ -188,22 +188,72 @@ fn scatter_pseudo<F: Lane>(pseudo: &[Shared<PseudoRow>], idx: [u32; LANES], v: &
     }
 }
 
-/// A batch's two sides during a kernel: velocities loaded, written back by [`Pair::store`].
-struct Pair<F> {
-    a: Velocities<F>,
-    b: Velocities<F>,
-    inv_mass_a: F,
-    inv_mass_b: F,
+/// How an impulse changes a body's linear velocity: by 1/m (`F`, a batch without
+/// translation locks, [`ManifoldLanes::locked`]) or by 1/m along each world axis
+/// (`V3x8<F>`). The kernels are generic over it, so that batches without locks keep one
+/// register per side for it.
+trait LinearResponse<F: Lane>: Copy {
+    /// From a batch's per-axis inverse masses ([`ManifoldLanes::inv_mass_a`]).
+    fn from_axes(axes: V3x8<F>) -> Self;
+    /// The velocity change of the impulse `impulse`.
+    fn times(self, impulse: V3x8<F>) -> V3x8<F>;
 }
 
-impl<F: Lane> Pair<F> {
+impl<F: Lane> LinearResponse<F> for F {
+    #[inline(always)]
+    fn from_axes(axes: V3x8<F>) -> Self {
+        axes.x
+    }
+    #[inline(always)]
+    fn times(self, impulse: V3x8<F>) -> V3x8<F> {
+        impulse * self
+    }
+}
+
+impl<F: Lane> LinearResponse<F> for V3x8<F> {
+    #[inline(always)]
+    fn from_axes(axes: V3x8<F>) -> Self {
+        axes
+    }
+    #[inline(always)]
+    fn times(self, impulse: V3x8<F>) -> V3x8<F> {
+        impulse.scale(self)
+    }
+}
+
+/// A batch's two sides during a kernel: velocities loaded, written back by [`Pair::store`].
+struct Pair<F, L = F> {
+    a: Velocities<F>,
+    b: Velocities<F>,
+    /// 1/m, or 1/m along each world axis ([`LinearResponse`]).
+    inv_mass_a: L,
+    inv_mass_b: L,
+}
+
+impl<F: Lane> Pair<F, F> {
+    /// [`Pair::load`] for a batch without translation locks.
+    #[inline(always)]
+    fn load_plain(m: &ManifoldLanes<F>, states: &[Shared<BodyState>]) -> Self {
+        Self::load(m, states)
+    }
+}
+
+impl<F: Lane> Pair<F, V3x8<F>> {
+    /// [`Pair::load`] for a batch with a translation lock.
+    #[inline(always)]
+    fn load_axes(m: &ManifoldLanes<F>, states: &[Shared<BodyState>]) -> Self {
+        Self::load(m, states)
+    }
+}
+
+impl<F: Lane, L: LinearResponse<F>> Pair<F, L> {
     #[inline(always)]
     fn load(m: &ManifoldLanes<F>, states: &[Shared<BodyState>]) -> Self {
         Self {
             a: gather_velocities(states, m.a),
             b: gather_velocities(states, m.b),
-            inv_mass_a: m.inv_mass_a,
-            inv_mass_b: m.inv_mass_b,
+            inv_mass_a: L::from_axes(m.inv_mass_a),
+            inv_mass_b: L::from_axes(m.inv_mass_b),
         }
     }
 
@@ -224,9 +274,9 @@ impl<F: Lane> Pair<F> {
     #[inline(always)]
     fn apply_normal(&mut self, p: &PointLanes<F>, lambda: F) {
         let impulse = p.normal * lambda;
-        self.a.linear += impulse * self.inv_mass_a;
+        self.a.linear += self.inv_mass_a.times(impulse);
         self.a.angular += p.ang_a_normal * lambda;
-        self.b.linear -= impulse * self.inv_mass_b;
+        self.b.linear -= self.inv_mass_b.times(impulse);
         self.b.angular -= p.ang_b_normal * lambda;
     }
 
@@ -234,9 +284,9 @@ impl<F: Lane> Pair<F> {
     #[inline(always)]
     fn apply_tangent(&mut self, p: &PointLanes<F>, l1: F, l2: F) {
         let impulse = p.tangent1 * l1 + p.tangent2 * l2;
-        self.a.linear += impulse * self.inv_mass_a;
+        self.a.linear += self.inv_mass_a.times(impulse);
         self.a.angular += p.ang_a_tangent1 * l1 + p.ang_a_tangent2 * l2;
-        self.b.linear -= impulse * self.inv_mass_b;
+        self.b.linear -= self.inv_mass_b.times(impulse);
         self.b.angular -= p.ang_b_tangent1 * l1 + p.ang_b_tangent2 * l2;
     }
 }
@@ -293,16 +343,29 @@ macro_rules! for_each_batch {
         let all_points = $points;
         let base: u32 = $base;
         for $m in $manifolds.iter() {
-            let mut pair = Pair::load($m, states);
             let first = ($m.first - base) as usize;
             let range = first..first + $m.count as usize;
-            {
-                let $pair = &mut pair;
-                let $pts = &mut all_points[range];
-                let $st: &[Shared<BodyState>] = states;
-                $body
+            // The body twice: batches with a translation lock apply impulses through
+            // per-axis inverse masses, the others through one.
+            if $m.locked {
+                let mut pair = Pair::load_axes($m, states);
+                {
+                    let $pair = &mut pair;
+                    let $pts = &mut all_points[range];
+                    let $st: &[Shared<BodyState>] = states;
+                    $body
+                }
+                pair.store($m, states);
+            } else {
+                let mut pair = Pair::load_plain($m, states);
+                {
+                    let $pair = &mut pair;
+                    let $pts = &mut all_points[range];
+                    let $st: &[Shared<BodyState>] = states;
+                    $body
+                }
+                pair.store($m, states);
             }
-            pair.store($m, states);
         }
     }};
 }
@@ -361,7 +424,7 @@ const DISK_PROJECTION_ITERATIONS: usize = 4;
 /// the rotational terms make K anisotropic (at a box's corners) it turns the friction away from
 /// −v_t, and a box sliding on the ground felt only 0.936·μ.
 #[inline(always)]
-fn solve_friction<F: Lane>(pair: &mut Pair<F>, p: &mut PointLanes<F>) {
+fn solve_friction<F: Lane, L: LinearResponse<F>>(pair: &mut Pair<F, L>, p: &mut PointLanes<F>) {
     let dv = pair.relative_velocity(p);
     let (vt1, vt2) = (dv.dot(p.tangent1), dv.dot(p.tangent2));
     let [k0, k1, k2] = p.tangent_mass;
@@ -446,7 +509,11 @@ fn project_to_disk<F: Lane>(inv_k: [F; 3], target: [F; 2], r: F, over: F::Mask) 
 /// Adds `delta` to the point's accumulated normal impulse, clamped so that the total never
 /// pulls (≥ 0), and applies the change that remains to the pair.
 #[inline(always)]
-fn accumulate_normal<F: Lane>(pair: &mut Pair<F>, p: &mut PointLanes<F>, delta: F) {
+fn accumulate_normal<F: Lane, L: LinearResponse<F>>(
+    pair: &mut Pair<F, L>,
+    p: &mut PointLanes<F>,
+    delta: F,
+) {
     let total = (p.normal_impulse + delta).max(F::ZERO);
     let delta = total - p.normal_impulse;
     p.normal_impulse = total;
@@ -458,20 +525,35 @@ fn accumulate_normal<F: Lane>(pair: &mut Pair<F>, p: &mut PointLanes<F>, delta: 
 /// most its gap within the substep), as the relax pass and rigid contacts solve it; `s` is
 /// the point's separation now ([`separation`]).
 #[inline(always)]
-fn solve_normal_rigid<F: Lane>(pair: &mut Pair<F>, p: &mut PointLanes<F>, s: F, inv_h: F) {
+fn solve_normal_rigid<F: Lane, L: LinearResponse<F>>(
+    pair: &mut Pair<F, L>,
+    p: &mut PointLanes<F>,
+    s: F,
+    inv_h: F,
+) {
     accumulate_normal(pair, p, rigid_row(pair, p, s, inv_h));
 }
 
 /// The increment of one rigid, unbiased normal row before the clamp ([`solve_normal_rigid`]).
 #[inline(always)]
-fn rigid_row<F: Lane>(pair: &Pair<F>, p: &PointLanes<F>, s: F, inv_h: F) -> F {
+fn rigid_row<F: Lane, L: LinearResponse<F>>(
+    pair: &Pair<F, L>,
+    p: &PointLanes<F>,
+    s: F,
+    inv_h: F,
+) -> F {
     -p.normal_mass * rigid_residual(pair, p, s, inv_h)
 }
 
 /// What a rigid row asks to remove: the normal velocity, plus a speculative point's gap
 /// rule s/h (it may close at most its gap `s` within the substep).
 #[inline(always)]
-fn rigid_residual<F: Lane>(pair: &Pair<F>, p: &PointLanes<F>, s: F, inv_h: F) -> F {
+fn rigid_residual<F: Lane, L: LinearResponse<F>>(
+    pair: &Pair<F, L>,
+    p: &PointLanes<F>,
+    s: F,
+    inv_h: F,
+) -> F {
     let bias = F::select(s.cmpgt(F::ZERO), s * inv_h, F::ZERO);
     let vn = pair.relative_velocity(p).dot(p.normal);
     vn + bias
@@ -560,16 +642,16 @@ fn pseudo_normal_velocity<F: Lane>(
 
 /// Applies the pseudo impulse `push` (on A along n, on B opposite) to the pseudo velocities.
 #[inline(always)]
-fn apply_pseudo<F: Lane>(
+fn apply_pseudo<F: Lane, L: LinearResponse<F>>(
     pseudo: &mut (Velocities<F>, Velocities<F>),
-    pair: &Pair<F>,
+    pair: &Pair<F, L>,
     p: &PointLanes<F>,
     push: F,
 ) {
     let impulse = p.normal * push;
-    pseudo.0.linear += impulse * pair.inv_mass_a;
+    pseudo.0.linear += pair.inv_mass_a.times(impulse);
     pseudo.0.angular += p.ang_a_normal * push;
-    pseudo.1.linear -= impulse * pair.inv_mass_b;
+    pseudo.1.linear -= pair.inv_mass_b.times(impulse);
     pseudo.1.angular -= p.ang_b_normal * push;
 }
 
@@ -577,9 +659,9 @@ fn apply_pseudo<F: Lane>(
 /// speculative point keeps its gap rule), then its friction; with `sweeps` > 1 (rigid
 /// contacts) all the normal rows `sweeps` times first, then the friction.
 #[inline(always)]
-fn relax_batch<F: Lane>(
+fn relax_batch<F: Lane, L: LinearResponse<F>>(
     m: &ManifoldLanes<F>,
-    pair: &mut Pair<F>,
+    pair: &mut Pair<F, L>,
     points: &mut [PointLanes<F>],
     states: &[Shared<BodyState>],
     inv_h: f32,
@@ -655,14 +737,18 @@ fn factor_block<F: Lane>(m: &ManifoldLanes<F>, points: &[PointLanes<F>]) -> [F; 
         rn_a[i] = p.r_a.cross(p.normal);
         rn_b[i] = p.r_b.cross(p.normal);
     }
-    let m_sum = m.inv_mass_a + m.inv_mass_b;
+    let m_axes = m.inv_mass_a + m.inv_mass_b;
+    let (m_sum, uniform) = (m_axes.x, m.inv_mass_a.uniform() & m.inv_mass_b.uniform());
     let mut k = [[F::ZERO; MAX_POINTS]; MAX_POINTS];
     for i in 0..n {
         for j in 0..=i {
             let (pi, pj) = (&points[i], &points[j]);
-            let kij = pi.normal.dot(pj.normal) * m_sum
-                + rn_a[i].dot(pj.ang_a_normal)
-                + rn_b[i].dot(pj.ang_b_normal);
+            let linear = F::select(
+                uniform,
+                pi.normal.dot(pj.normal) * m_sum,
+                m_axes.scale(pi.normal).dot(pj.normal),
+            );
+            let kij = linear + rn_a[i].dot(pj.ang_a_normal) + rn_b[i].dot(pj.ang_b_normal);
             k[i][j] = kij;
             k[j][i] = kij;
         }
@@ -700,9 +786,9 @@ fn factor_block<F: Lane>(m: &ManifoldLanes<F>, points: &[PointLanes<F>]) -> [F; 
 /// friction in order ([`super::SoftStepSettings::block_relax`], an experiment).
 #[allow(clippy::needless_range_loop)]
 #[inline(always)]
-fn relax_block<F: Lane>(
+fn relax_block<F: Lane, L: LinearResponse<F>>(
     m: &ManifoldLanes<F>,
-    pair: &mut Pair<F>,
+    pair: &mut Pair<F, L>,
     points: &mut [PointLanes<F>],
     states: &[Shared<BodyState>],
     inv_h: F,
@@ -769,7 +855,12 @@ fn relax_block<F: Lane>(
 
 /// One point of a single relax sweep: its normal row, then its friction.
 #[inline(always)]
-fn relax_point<F: Lane>(m: &ManifoldLanes<F>, pair: &mut Pair<F>, p: &mut PointLanes<F>, inv_h: F) {
+fn relax_point<F: Lane, L: LinearResponse<F>>(
+    m: &ManifoldLanes<F>,
+    pair: &mut Pair<F, L>,
+    p: &mut PointLanes<F>,
+    inv_h: F,
+) {
     solve_normal_rigid(pair, p, p.separation, inv_h);
     if m.friction {
         solve_friction(pair, p);
@@ -818,9 +909,9 @@ pub struct BiasedPass {
 /// real velocity, and no spring lets a loaded contact sink: the overlap a step leaves is the
 /// slop plus what the unconverged solve let through.
 #[inline(always)]
-fn solve_batch_rigid<F: Lane>(
+fn solve_batch_rigid<F: Lane, L: LinearResponse<F>>(
     m: &ManifoldLanes<F>,
-    pair: &mut Pair<F>,
+    pair: &mut Pair<F, L>,
     pseudo: &mut (Velocities<F>, Velocities<F>),
     live: &mut bool,
     points: &mut [PointLanes<F>],
@@ -905,8 +996,8 @@ struct BiasedRow<F> {
 
 /// `s` is the point's separation now ([`separation`]).
 #[inline(always)]
-fn biased_row<F: Lane>(
-    pair: &Pair<F>,
+fn biased_row<F: Lane, L: LinearResponse<F>>(
+    pair: &Pair<F, L>,
     p: &PointLanes<F>,
     s: F,
     c: &BiasedConsts<F>,
@@ -972,9 +1063,9 @@ fn biased_row<F: Lane>(
 /// ([`super::integrate::integrate_positions`]). Speculative points (a gap) keep the rigid gap
 /// rule on the real velocity and get no pseudo impulse.
 #[inline(always)]
-fn solve_batch_split<F: Lane>(
+fn solve_batch_split<F: Lane, L: LinearResponse<F>>(
     m: &ManifoldLanes<F>,
-    pair: &mut Pair<F>,
+    pair: &mut Pair<F, L>,
     pseudo: &mut (Velocities<F>, Velocities<F>),
     live: &mut bool,
     points: &mut [PointLanes<F>],
@@ -1107,9 +1198,22 @@ fn relax_impl<F: Lane>(
         let mut twos = manifolds.chunks_exact(2);
         for two in &mut twos {
             let (m0, m1) = (&two[0], &two[1]);
+            if m0.locked || m1.locked {
+                // A translation lock: one batch after the other (the same results).
+                for_each_batch!(
+                    two,
+                    &mut *points,
+                    base,
+                    states,
+                    |m, pair, points, states| {
+                        relax_batch(m, pair, points, states, inv_h, sweeps);
+                    }
+                );
+                continue;
+            }
             let (p0, p1) = two_batches(points, base, m0, m1);
-            let mut pair0 = Pair::load(m0, states);
-            let mut pair1 = Pair::load(m1, states);
+            let mut pair0 = Pair::load_plain(m0, states);
+            let mut pair1 = Pair::load_plain(m1, states);
             store_separations(m0, p0, states);
             store_separations(m1, p1, states);
             for k in 0..p0.len().max(p1.len()) {
@@ -1237,7 +1341,9 @@ pub fn bounce_marks(batches: &Batches, threshold: f32, bodies: usize, marks: &mu
             .fold(0, |acc, p| acc | bounces(p, threshold).bitmask());
         for lane in (0..LANES).filter(|&l| lanes & (1 << l) != 0) {
             let (a, b) = (m.a[lane] as usize, m.b[lane] as usize);
-            let (moves_a, moves_b) = (m.inv_mass_a[lane] > 0.0, m.inv_mass_b[lane] > 0.0);
+            // (A body locked along every axis counts as not moving here.)
+            let moves = |v: &V3x8| v.lane(lane).max_element() > 0.0;
+            let (moves_a, moves_b) = (moves(&m.inv_mass_a), moves(&m.inv_mass_b));
             let mark = if moves_a && moves_b {
                 BOUNCES_ON_MOVING
             } else {
@@ -1329,9 +1435,9 @@ pub fn restitution(
                     F8::select(now.mass.cmpgt(F8::ZERO), delta.abs() / now.mass, F8::ZERO);
                 largest = largest.max(correction);
                 let impulse = p.normal * delta;
-                pair.a.linear += impulse * pair.inv_mass_a;
+                pair.a.linear += pair.inv_mass_a.times(impulse);
                 pair.a.angular += now.ang_a * delta;
-                pair.b.linear -= impulse * pair.inv_mass_b;
+                pair.b.linear -= pair.inv_mass_b.times(impulse);
                 pair.b.angular -= now.ang_b * delta;
             }
         }
@@ -1381,7 +1487,13 @@ pub fn restitution_response(batches: &Batches, inv_inertia_now: &[Mat3], out: &m
                 let ang_b = inertia(m.b[lane]) * rn_b;
                 r.ang_a.set_lane(lane, ang_a);
                 r.ang_b.set_lane(lane, ang_b);
-                let k = m.inv_mass_a[lane] + m.inv_mass_b[lane] + rn_a.dot(ang_a) + rn_b.dot(ang_b);
+                let (ma, mb) = (m.inv_mass_a.lane(lane), m.inv_mass_b.lane(lane));
+                let linear = if ma.x == ma.y && ma.y == ma.z && mb.x == mb.y && mb.y == mb.z {
+                    ma.x + mb.x
+                } else {
+                    n.dot((ma + mb) * n)
+                };
+                let k = linear + rn_a.dot(ang_a) + rn_b.dot(ang_b);
                 if k > 0.0 && k.is_finite() {
                     1.0 / k
                 } else {
