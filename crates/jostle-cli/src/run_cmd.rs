@@ -304,6 +304,16 @@ fn json_summary(scene: &str, resolver: &str, dt: f32, bodies: usize, s: &RunSumm
         "awake_final": s.awake_final,
         "all_asleep_step": s.all_asleep_step,
         "quarantined": s.quarantined.len(),
+        "picks_per_step": {
+            "position": s.picks_per_step[0],
+            "velocity": s.picks_per_step[1],
+        },
+        "residual": {
+            "position_median_m": s.residual_median[0],
+            "position_max_m": s.residual_max[0],
+            "velocity_median_m_per_s": s.residual_median[1],
+            "velocity_max_m_per_s": s.residual_max[1],
+        },
     })
     .to_string()
 }
@@ -341,6 +351,18 @@ fn print_table(scene: &str, resolver: &str, dt: f32, bodies: usize, s: &RunSumma
         (
             "largest penetration, whole run (m)".into(),
             format!("{:.5}", s.max_penetration_run),
+        ),
+        (
+            "picks per step, position / velocity".into(),
+            format!("{:.1} / {:.1}", s.picks_per_step[0], s.picks_per_step[1]),
+        ),
+        (
+            "left unresolved, median / max: position (m)".into(),
+            format!("{:.2e} / {:.2e}", s.residual_median[0], s.residual_max[0]),
+        ),
+        (
+            "left unresolved, median / max: velocity (m/s)".into(),
+            format!("{:.2e} / {:.2e}", s.residual_median[1], s.residual_max[1]),
         ),
         ("bodies awake at end".into(), s.awake_final.to_string()),
         (

@@ -29,6 +29,16 @@ pub struct ResolveStats {
     pub position_iterations: u32,
     /// Velocity iterations (picks) performed.
     pub velocity_iterations: u32,
+    /// What the position pass left unresolved: the largest key of any contact when it
+    /// stopped (the Millington resolver: the deepest penetration, m), at its epsilon or below
+    /// when it converged, above it when its budget ran out. 0 for resolvers without such a
+    /// pass.
+    pub position_residual: f32,
+    /// What the velocity pass left unresolved: the largest key of any contact when it
+    /// stopped (the Millington resolver: the largest velocity change still wanted, the
+    /// normal one or the sliding speed friction can still take, m/s). 0 for resolvers
+    /// without such a pass.
+    pub velocity_residual: f32,
     /// Independent contact islands solved.
     pub islands: u32,
     /// Threads that could take part in the step (the soft step's team, 1 when it ran alone;

@@ -184,6 +184,7 @@ impl MillingtonResolver {
             &settings.position_iterations,
             settings.position_epsilon,
         );
+        stats.position_residual = self.scratch.residual;
         self.work[0] = std::mem::take(&mut self.scratch.work);
         stats.position_time = start.elapsed();
 
@@ -244,6 +245,7 @@ impl MillingtonResolver {
             &settings.velocity_iterations,
             settings.velocity_epsilon,
         );
+        stats.velocity_residual = self.scratch.residual;
         self.work[1] = std::mem::take(&mut self.scratch.work);
         bound_bounce_energy(&self.bounce_marks, &self.before_velocity, bodies);
         for (c, p) in contacts.iter_mut().zip(&self.prepared) {

@@ -92,6 +92,9 @@ pub(crate) struct PickScratch {
     pub(crate) heap: IndexedMaxHeap,
     pub(crate) stamps: Stamps,
     pub(crate) work: PickWork,
+    /// The largest key any island was left with by the last [`run_islands`] (0 when none
+    /// was left above 0): what the pass did not resolve, in the pass's own units.
+    pub(crate) residual: f32,
 }
 
 impl PickScratch {
@@ -113,7 +116,12 @@ pub(crate) fn run_heap<P: Pass>(
     epsilon: f32,
     budget: u32,
 ) -> u32 {
-    let PickScratch { heap, stamps, work } = scratch;
+    let PickScratch {
+        heap,
+        stamps,
+        work,
+        residual,
+    } = scratch;
     heap.build(island, |c| pass.key(c));
     let moves_before = heap.moves();
     let mut picks = 0;
@@ -147,6 +155,11 @@ pub(crate) fn run_heap<P: Pass>(
         keys_read: updates,
         heap_moves: heap.moves() - moves_before,
     };
+    if let Some((_, key)) = heap.peek()
+        && key > *residual
+    {
+        *residual = key;
+    }
     picks
 }
 
@@ -158,6 +171,7 @@ pub(crate) fn run_linear_scan<P: Pass>(
     epsilon: f32,
     budget: u32,
     work: &mut PickWork,
+    residual: &mut f32,
 ) -> u32 {
     let mut picks = 0;
     while picks < budget {
@@ -181,6 +195,12 @@ pub(crate) fn run_linear_scan<P: Pass>(
             pass.update(c, &change);
         }
     }
+    for &c in island {
+        let key = pass.key(c);
+        if key > *residual {
+            *residual = key;
+        }
+    }
     let scanned = island.len() as u64 * u64::from(picks);
     *work += PickWork {
         picks: u64::from(picks),
@@ -192,7 +212,8 @@ pub(crate) fn run_linear_scan<P: Pass>(
 }
 
 /// Runs one pass over every island with the chosen pick strategy, each island with its own
-/// budget; returns the picks made.
+/// budget; returns the picks made, and leaves the largest key left in
+/// [`PickScratch::residual`].
 pub(crate) fn run_islands<P: Pass>(
     pass: &mut P,
     islands: &Islands,
@@ -202,6 +223,7 @@ pub(crate) fn run_islands<P: Pass>(
     epsilon: f32,
 ) -> u32 {
     let mut picks = 0;
+    scratch.residual = 0.0;
     for i in 0..islands.len() {
         let island = islands.island(i);
         let budget = budget.for_contacts(island.len());
@@ -209,9 +231,14 @@ pub(crate) fn run_islands<P: Pass>(
             super::settings::PickStrategy::Heap => {
                 run_heap(pass, island, islands, scratch, epsilon, budget)
             }
-            super::settings::PickStrategy::LinearScan => {
-                run_linear_scan(pass, island, epsilon, budget, &mut scratch.work)
-            }
+            super::settings::PickStrategy::LinearScan => run_linear_scan(
+                pass,
+                island,
+                epsilon,
+                budget,
+                &mut scratch.work,
+                &mut scratch.residual,
+            ),
         };
     }
     picks
