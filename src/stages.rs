@@ -195,22 +195,28 @@ pub(crate) fn gather(
             body.inv_mass(),
             body.inv_inertia_world(),
         );
-        for (axis, bit) in [SolverBody::LOCK_X, SolverBody::LOCK_Y, SolverBody::LOCK_Z]
-            .into_iter()
-            .enumerate()
-        {
-            if body.translation_locks()[axis] {
-                sb.flags |= bit;
+        // Translation locks hold dynamic bodies; a kinematic body goes where it is sent.
+        if !body.is_kinematic() {
+            for (axis, bit) in [SolverBody::LOCK_X, SolverBody::LOCK_Y, SolverBody::LOCK_Z]
+                .into_iter()
+                .enumerate()
+            {
+                if body.translation_locks()[axis] {
+                    sb.flags |= bit;
+                }
             }
         }
         // The forces' velocity change goes to the resolver to add over the step, not at once.
-        sb.linear_velocity = v0;
+        // (Along a locked axis neither the velocity nor the forces act: a body turned from
+        // kinematic to dynamic, or read from a snapshot, may come with such a velocity.)
+        let free = sb.linear_freedom();
+        sb.linear_velocity = v0 * free;
         sb.angular_velocity = w0;
-        sb.force_velocity = body.linear_velocity - v0;
+        sb.force_velocity = (body.linear_velocity - v0) * free;
         if body.gravity_scale != 1.0 {
             // The resolver adds the world's gravity to every body; the rest of a scaled one's
             // is one more force, spread over the step like the others.
-            sb.force_velocity += gravity * ((body.gravity_scale - 1.0) * dt);
+            sb.force_velocity += gravity * ((body.gravity_scale - 1.0) * dt) * free;
         }
         sb.torque_velocity = body.angular_velocity - w0;
         sb.last_acceleration = body.last_acceleration;
@@ -609,7 +615,11 @@ pub(crate) fn scatter(
                 + turned_sq * inv_dt * inv_dt;
         body.position = solver.position;
         body.orientation = solver.orientation;
-        body.linear_velocity = body.without_locked_motion(solver.linear_velocity);
+        body.linear_velocity = if body.is_kinematic() {
+            solver.linear_velocity
+        } else {
+            body.without_locked_motion(solver.linear_velocity)
+        };
         // (A locked axis gains no turn in the solve but for rounding, which is dropped.)
         body.angular_velocity = body.without_locked_turn(solver.angular_velocity);
         body.last_acceleration = solver.last_acceleration;

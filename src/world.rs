@@ -1034,18 +1034,8 @@ impl World {
         handle: BodyHandle,
         locks: [bool; 3],
     ) -> Result<(), StepError> {
-        if self
-            .bodies
-            .get(handle)
-            .ok_or(StepError::InvalidHandle(handle))?
-            .is_fixed()
-        {
-            return Err(invalid((
-                "rotation_locks",
-                "a fixed body does not turn: make it dynamic first".into(),
-            )));
-        }
-        self.body_mut_awake(handle)?.set_rotation_locks(locks);
+        self.unfixed_body_mut(handle, "rotation_locks", "a fixed body does not turn")?
+            .set_rotation_locks(locks);
         Ok(())
     }
 
@@ -1074,19 +1064,28 @@ impl World {
         handle: BodyHandle,
         locks: [bool; 3],
     ) -> Result<(), StepError> {
+        self.unfixed_body_mut(handle, "translation_locks", "a fixed body does not move")?
+            .set_translation_locks(locks);
+        Ok(())
+    }
+
+    /// The body of `handle`, woken, unless it is fixed: then an error naming `field` says
+    /// `why` and to make it dynamic first.
+    fn unfixed_body_mut(
+        &mut self,
+        handle: BodyHandle,
+        field: &'static str,
+        why: &str,
+    ) -> Result<&mut RigidBody, StepError> {
         if self
             .bodies
             .get(handle)
             .ok_or(StepError::InvalidHandle(handle))?
             .is_fixed()
         {
-            return Err(invalid((
-                "translation_locks",
-                "a fixed body does not move: make it dynamic first".into(),
-            )));
+            return Err(invalid((field, format!("{why}: make it dynamic first"))));
         }
-        self.body_mut_awake(handle)?.set_translation_locks(locks);
-        Ok(())
+        self.body_mut_awake(handle)
     }
 
     /// Allows or forbids a body to sleep; forbidding wakes it (and its island).

@@ -195,7 +195,7 @@ fn million_to_one_case(
         BodyDesc::fixed(
             "floor",
             ShapeDesc::Cuboid {
-                half_extents: Vec3::new(100.0, 0.05, 100.0),
+                half_extents: Vec3::new(10.0, 0.05, 10.0),
             },
         )
         .at(Vec3::new(0.0, -0.05, 0.0))

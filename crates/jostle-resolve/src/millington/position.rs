@@ -131,8 +131,17 @@ pub fn apply_moves(
             continue;
         };
         // Along n, or as near it as a translation lock allows, advancing `moves.linear`
-        // along n all the same.
-        let linear = b.linear_direction(n) * moves.linear[side];
+        // along n all the same; but no farther than the move itself, which a normal nearly
+        // along a locked axis (a direction of length 1/sin of their angle) could make
+        // arbitrarily long.
+        let mut linear = b.linear_direction(n) * moves.linear[side];
+        if b.flags & SolverBody::LOCKS != 0 {
+            let length = linear.length();
+            let most = moves.linear[side].abs();
+            if length > most {
+                linear *= most / length;
+            }
+        }
         b.position += linear;
         change.linear[side] = linear;
         let rotation = moves.rotation[side];

@@ -29,7 +29,8 @@ use jostle_math::{Mat3, Vec3, skew};
 pub const DYNAMIC_FRICTION_MIN_RESPONSE: f32 = 0.25;
 
 /// The lecture's Δq̇_t: velocity change along the normal per unit impulse along the normal,
-/// Σ 1/m + ((I⁻¹(r×n))×r)·n over the moving sides (computed once by
+/// Σ 1/m + ((I⁻¹(r×n))×r)·n over the moving sides, with n·W·n for 1/m where a side's
+/// translation is locked (W its per-axis inverse mass; computed once by
 /// [`super::prepare::prepare`]).
 #[inline]
 pub fn velocity_change_per_unit_impulse(p: &PreparedContact) -> f32 {
@@ -38,7 +39,9 @@ pub fn velocity_change_per_unit_impulse(p: &PreparedContact) -> f32 {
 
 /// The contact-space matrix K mapping a contact-space impulse on A to the change of A's
 /// closing velocity relative to B (seed lecture, "Computing Impulse"):
-/// K = Mᵀ (Σ −\[r\]× I⁻¹ \[r\]×) M + (Σ 1/m) 𝟙, summed over the moving sides, M the basis.
+/// K = Bᵀ (Σ −\[r\]× I⁻¹ \[r\]× + Σ W) B, summed over the moving sides, B the basis and W
+/// the side's inverse mass: (1/m)·𝟙, or diagonal with zeros along translation-locked world
+/// axes ([`SolverBody::inv_mass_axes`]).
 pub fn impulse_matrix(p: &PreparedContact, bodies: &[SolverBody]) -> Mat3 {
     let mut angular = Mat3::ZERO;
     let mut inv_mass = 0.0;
@@ -90,9 +93,10 @@ pub fn frictionless_impulse(p: &PreparedContact) -> Vec3 {
 /// The impulse with friction (contact space) that a pick of `p` applies: solve
 /// K g = (Δv, −v_y, −v_z) for the impulse that gives the desired normal change and kills the
 /// sliding velocity (seed lecture, "Computing Impulse"), then limit the step's **total**
-/// impulse `p.impulse + g` with [`coulomb_accumulated`]. Falls back to
-/// [`frictionless_impulse`] when K is singular (a body that rotates but cannot translate) or
-/// the contact cannot be resolved.
+/// impulse `p.impulse + g` with [`coulomb_accumulated`]. A tangent direction nothing can move
+/// along (bodies kept in a plane by their locks) gets no friction and the rest is solved
+/// ([`without_dead_tangents`]). Falls back to [`frictionless_impulse`] when K is otherwise
+/// singular or the contact cannot be resolved.
 ///
 /// A contact that has applied no normal impulse this step and wants none (Δv ≤ 0) has no
 /// friction to give: the impulse is zero. When it has, a negative desired normal change (it
@@ -126,7 +130,7 @@ pub fn friction_pick(p: &PreparedContact, bodies: &[SolverBody]) -> FrictionPick
     if !(p.normal_inertia > 0.0) {
         return no_friction(Vec3::ZERO);
     }
-    let k = impulse_matrix(p, bodies);
+    let (k, dead) = without_dead_tangents(impulse_matrix(p, bodies));
     let det = k.determinant();
     let scale = k.x_axis.x * k.y_axis.y * k.z_axis.z;
     if !(det.abs() > 1e-6 * scale) {
@@ -143,10 +147,37 @@ pub fn friction_pick(p: &PreparedContact, bodies: &[SolverBody]) -> FrictionPick
     } else {
         p.desired_delta_velocity
     };
-    let target = Vec3::new(desired, -p.velocity.y, -p.velocity.z);
-    let g = k.inverse() * target;
-    coulomb_accumulated(p.impulse, g, k, desired, p.friction, p.velocity)
+    let live = Vec3::new(1.0, f32::from(!dead[0]), f32::from(!dead[1]));
+    let target = Vec3::new(desired, -p.velocity.y, -p.velocity.z) * live;
+    let g = (k.inverse() * target) * live;
+    coulomb_accumulated(p.impulse, g, k, desired, p.friction, p.velocity * live)
 }
+
+/// `k` with each tangent direction that no impulse can move (its row and column zero to
+/// rounding: both bodies locked against it, as a body kept in a plane is against the plane's
+/// normal by its translation and rotation locks) replaced by the identity's, and which ones
+/// were: the friction there is zero and the other directions are solved as usual. Without it
+/// such a K is singular and the contact got no friction at all.
+fn without_dead_tangents(mut k: Mat3) -> (Mat3, [bool; 2]) {
+    let trace = k.x_axis.x + k.y_axis.y + k.z_axis.z;
+    let mut dead = [false; 2];
+    for (i, d) in dead.iter_mut().enumerate() {
+        let axis = i + 1;
+        if k.col(axis)[axis] <= DEAD_DIRECTION * trace {
+            *d = true;
+            for j in 0..3 {
+                k.col_mut(axis)[j] = 0.0;
+                k.col_mut(j)[axis] = 0.0;
+            }
+            k.col_mut(axis)[axis] = 1.0;
+        }
+    }
+    (k, dead)
+}
+
+/// A contact-space direction whose response is below this fraction of K's trace is taken as
+/// one no impulse can move ([`without_dead_tangents`]).
+const DEAD_DIRECTION: f32 = 1e-9;
 
 /// The seed lecture's static/dynamic Coulomb test ("Friction as Impulses") for a single pick
 /// with nothing accumulated: [`coulomb_accumulated`] with a zero accumulated impulse, returning

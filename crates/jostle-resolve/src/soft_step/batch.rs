@@ -131,9 +131,10 @@ pub struct ManifoldLanes<F = F8> {
     pub count: u32,
     /// Whether any point of any lane has friction (μ > 0): otherwise friction is skipped.
     pub friction: bool,
-    /// Whether the body of some lane has a translation lock (its inverse mass differs
-    /// between axes): the kernels then apply impulses through [`ManifoldLanes::inv_mass_a`]
-    /// axis by axis, otherwise through its x component alone.
+    /// Whether the body of some lane has an inverse mass that differs between axes (a
+    /// translation lock on some but not all axes): the kernels then apply impulses through
+    /// [`ManifoldLanes::inv_mass_a`] axis by axis, otherwise through its x component alone
+    /// (which is 0 for a body locked along every axis, as its other components are).
     pub locked: bool,
     /// The Cholesky factor L of the batch's block system K + ε·diag(K) over its points
     /// ([`super::solve::factor_blocks`], for the block relax): L's entries below the

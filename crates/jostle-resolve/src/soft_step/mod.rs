@@ -787,11 +787,12 @@ fn allowed_energy(
     gravity: jostle_math::Vec3,
 ) -> f32 {
     let mass = 1.0 / start.inv_mass;
+    let free = start.linear_freedom();
     let (v, w) = (
-        start.linear_velocity + start.force_velocity,
+        start.linear_velocity + start.force_velocity * free,
         start.angular_velocity + start.torque_velocity,
     );
-    0.5 * mass * v.length_squared() + 0.5 * w.dot(inertia * w) + mass * gravity.dot(moved)
+    0.5 * mass * v.length_squared() + 0.5 * w.dot(inertia * w) + mass * (gravity * free).dot(moved)
 }
 
 impl Resolver for SoftStepResolver {
@@ -1029,7 +1030,7 @@ impl Resolver for SoftStepResolver {
         for (body, state) in bodies.iter_mut().zip(&self.states).skip(1) {
             state.store(body);
             body.last_acceleration = if body.inv_mass > 0.0 {
-                ctx.gravity
+                ctx.gravity * body.linear_freedom()
             } else {
                 jostle_math::Vec3::ZERO
             };

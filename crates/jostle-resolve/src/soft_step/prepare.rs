@@ -152,7 +152,9 @@ pub fn prepare_point<F: Lane>(
     let (t1, t2) = (zero_unless(present, t1), zero_unless(present, t2));
     let r_a = point - a.position;
     let r_b = point_b - b.position;
-    let m = a.inv_mass + b.inv_mass;
+    // 1/m as the kernels apply it (x of the per-axis inverse mass: the same as 1/m unless the
+    // body is locked along every axis, where it is 0).
+    let m = a.inv_mass_axes.x + b.inv_mass_axes.x;
     // Where a body's translation is locked on some axis, its inverse mass is a diagonal
     // matrix M: the rows' linear parts are u·(M_A + M_B)·v; elsewhere m·(u·v), with u·u
     // taken as 1 and t₁·t₂ as 0 as before.
@@ -180,7 +182,16 @@ pub fn prepare_point<F: Lane>(
     let det = k11 * k22 - k12 * k12;
     let invertible = det.cmpgt(F::splat(f32::EPSILON) * k11 * k22) & det.is_finite_mask();
     let inv_det = F::select(invertible, det.recip(), F::ZERO);
-    let tangent_mass = [k22 * inv_det, -k12 * inv_det, k11 * inv_det];
+    // A singular K (rank 1: the bodies cannot move along one tangent direction, as bodies
+    // kept in a plane by their locks cannot leave it) takes its pseudo-inverse K/tr(K)²:
+    // friction along the direction that moves, none along the other. (Zero for padding.)
+    let trace = k11 + k22;
+    let pseudo = F::select(trace.cmpgt(F::ZERO), (trace * trace).recip(), F::ZERO);
+    let tangent_mass = [
+        F::select(invertible, k22 * inv_det, k11 * pseudo),
+        F::select(invertible, -k12 * inv_det, k12 * pseudo),
+        F::select(invertible, k11 * inv_det, k22 * pseudo),
+    ];
 
     let fixed = a.inv_mass.cmpeq(F::ZERO) | b.inv_mass.cmpeq(F::ZERO);
     let (s, d) = (params.static_softness, params.dynamic_softness);
