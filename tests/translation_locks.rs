@@ -265,6 +265,76 @@ fn a_box_locked_along_every_axis_turns_in_place() {
     }
 }
 
+/// A light box kept in a plane under a box 1,000 times heavier (the soft step solves such an
+/// island directly, with the locked body's per-axis inverse mass): it carries the load, stays
+/// in its plane, and the pair stands. Soft step only: the Millington resolver lets a 1:1,000
+/// pair go with or without locks (`assets/mass_ratio_1000.ron --resolver millington`: the
+/// light box is squeezed out and the heavy one ends on the ground).
+#[test]
+fn a_locked_light_box_under_a_heavy_one_holds_it_in_its_plane() {
+    for resolver in &common::resolvers()[1..] {
+        let mut world = common::world_with(Vec3::new(0.0, -9.81, 0.0), resolver);
+        common::ground(&mut world, 0.6, 0.0);
+        let cube = |name: &str, y: f32, mass: f32| {
+            BodyDesc::dynamic(
+                name,
+                ShapeDesc::Cuboid {
+                    half_extents: Vec3::splat(0.5),
+                },
+            )
+            .at(Vec3::new(0.0, y, 0.0))
+            .with_mass(mass)
+            .with_material(0.6, 0.0)
+        };
+        let light = world
+            .add_body(
+                cube("light", 0.5, 1.0)
+                    .with_translation_locks([false, false, true])
+                    .with_rotation_locks([true, true, false]),
+            )
+            .unwrap();
+        let heavy = world.add_body(cube("heavy", 1.5, 1000.0)).unwrap();
+        // A sideways shove of the heavy box along z, which the light box must not follow.
+        world
+            .apply_impulse_at_point(heavy, Vec3::new(0.0, 0.0, 200.0), Vec3::new(0.0, 1.5, 0.0))
+            .unwrap();
+        for _ in 0..300 {
+            world.step(DT).unwrap();
+            assert_eq!(
+                world.body(light).unwrap().position.z,
+                0.0,
+                "{}",
+                resolver.name()
+            );
+        }
+        let (l, h) = (world.body(light).unwrap(), world.body(heavy).unwrap());
+        println!(
+            "{}: light at {}, heavy at {}",
+            resolver.name(),
+            l.position,
+            h.position
+        );
+        assert!(
+            (l.position.y - 0.5).abs() < 0.01,
+            "{}: light y {}",
+            resolver.name(),
+            l.position.y
+        );
+        assert!(
+            (h.position.y - 1.5).abs() < 0.02,
+            "{}: heavy y {}",
+            resolver.name(),
+            h.position.y
+        );
+        assert!(
+            l.position.x.abs() < 0.01,
+            "{}: light x {}",
+            resolver.name(),
+            l.position.x
+        );
+    }
+}
+
 #[test]
 fn locks_come_from_scene_files_survive_snapshots_and_change_at_run_time() {
     use jostle::scene::Scene;
