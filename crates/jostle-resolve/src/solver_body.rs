@@ -109,10 +109,17 @@ impl SolverBody {
     /// ([`SolverBody::LOCK_X`]).
     #[inline]
     pub fn linear_freedom(&self) -> Vec3 {
-        if self.flags & Self::LOCKS == 0 {
+        Self::freedom_of(self.flags)
+    }
+
+    /// [`SolverBody::linear_freedom`] of a body with the flags `flags` (also read from a
+    /// resolver's own copy of them).
+    #[inline]
+    pub fn freedom_of(flags: u32) -> Vec3 {
+        if flags & Self::LOCKS == 0 {
             return Vec3::ONE;
         }
-        let free = |bit: u32| if self.flags & bit == 0 { 1.0 } else { 0.0 };
+        let free = |bit: u32| if flags & bit == 0 { 1.0 } else { 0.0 };
         Vec3::new(free(Self::LOCK_X), free(Self::LOCK_Y), free(Self::LOCK_Z))
     }
 

@@ -77,15 +77,7 @@ impl BodyState {
     /// ([`SolverBody::LOCK_X`]; the flags are the solver body's).
     #[inline(always)]
     pub fn linear_freedom(&self) -> Vec3 {
-        if self.flags & SolverBody::LOCKS == 0 {
-            return Vec3::ONE;
-        }
-        let free = |bit: u32| if self.flags & bit == 0 { 1.0 } else { 0.0 };
-        Vec3::new(
-            free(SolverBody::LOCK_X),
-            free(SolverBody::LOCK_Y),
-            free(SolverBody::LOCK_Z),
-        )
+        SolverBody::freedom_of(self.flags)
     }
 
     /// The first eight floats: linear velocity, 1/m, angular velocity, and the flags' bits.
