@@ -94,6 +94,11 @@ pub struct PointLanes<F = F8> {
     pub tangent_mass: [F; 3],
     /// Accumulated friction impulse along t₁, t₂ (N·s).
     pub tangent_impulse: [F; 2],
+    /// What a unit normal impulse changes the relative velocity along t₁, t₂ by (m/s per
+    /// N·s): t·(M_A⁻¹ + M_B⁻¹)·n + (r_A × t)·I_A⁻¹·(r_A × n) + (r_B × t)·I_B⁻¹·(r_B × n).
+    /// The relax pass takes friction's velocity from its normal row's with it instead of
+    /// computing the relative velocity again.
+    pub normal_tangent: [F; 2],
     /// Restitution e.
     pub restitution: F,
     /// Normal relative velocity at the start of the step (m/s).
@@ -108,8 +113,8 @@ pub struct PointLanes<F = F8> {
     pub separation: F,
 }
 
-// 204 bytes per contact point: 11 vectors and 18 scalars, each eight lanes wide.
-const _: () = assert!(size_of::<PointLanes>() <= 204 * LANES);
+// 212 bytes per contact point: 11 vectors and 20 scalars, each eight lanes wide.
+const _: () = assert!(size_of::<PointLanes>() <= 212 * LANES);
 
 /// Eight manifolds (one per lane) with disjoint non-static bodies; their points are
 /// `points[first .. first + count]` of the [`Batches`].

@@ -1017,9 +1017,13 @@ impl Resolver for SoftStepResolver {
             c.impulse = jostle_math::Vec3::ZERO;
         }
         let (rate, target) = (self.settings.preload_rate, self.settings.preload_target);
+        // The relax pass of the last substep stored every point's separation at the poses
+        // the step ends with (nothing after it moves a body that has contacts).
+        let stored = substeps > 0 && self.settings.relax_iterations > 0;
         solve::results(
             &self.batches,
             &mut self.states,
+            stored,
             |i, impulse, separation, manifold| {
                 let c = &mut contacts[i as usize];
                 c.impulse = impulse * substeps as f32;

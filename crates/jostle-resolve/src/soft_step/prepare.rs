@@ -185,6 +185,11 @@ pub fn prepare_point<F: Lane>(
     // A singular K (rank 1: the bodies cannot move along one tangent direction, as bodies
     // kept in a plane by their locks cannot leave it) takes its pseudo-inverse K/tr(K)²:
     // friction along the direction that moves, none along the other. (Zero for padding.)
+    // What a normal impulse does along each tangent (the relax pass's friction reads it).
+    let normal_tangent = [
+        linear(n, t1, false) + rt_a[0].dot(ang_a_normal) + rt_b[0].dot(ang_b_normal),
+        linear(n, t2, false) + rt_a[1].dot(ang_a_normal) + rt_b[1].dot(ang_b_normal),
+    ];
     let trace = k11 + k22;
     let pseudo = F::select(trace.cmpgt(F::ZERO), (trace * trace).recip(), F::ZERO);
     let tangent_mass = [
@@ -237,6 +242,7 @@ pub fn prepare_point<F: Lane>(
             F::select(has_friction, warm.y, F::ZERO),
             F::select(has_friction, warm.z, F::ZERO),
         ],
+        normal_tangent,
         restitution: F::from_array(restitution),
         relative_velocity: dv.dot(n),
         preload,
