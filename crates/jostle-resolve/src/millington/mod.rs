@@ -69,8 +69,8 @@ mod worst_first;
 
 pub use change::{BodyChange, NO_BODY};
 pub use position::{
-    PenetrationMoves, apply_moves, linear_moves, nonlinear_moves, resolve_penetration,
-    update_penetration,
+    PenetrationMoves, apply_moves, linear_moves, nonlinear_moves, position_key, projection_depth,
+    resolve_penetration, update_penetration,
 };
 pub use prepare::{PreparedContact, desired_delta_velocity, impact_speed_gain, prepare};
 pub use priority_queue::IndexedMaxHeap;

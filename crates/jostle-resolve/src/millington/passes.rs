@@ -2,14 +2,15 @@
 //! how a contact is resolved, and how a neighbour is updated.
 
 use super::change::BodyChange;
-use super::position::{resolvable, resolve_penetration, update_penetration};
+use super::position::{position_key, resolvable, resolve_penetration, update_penetration};
 use super::prepare::PreparedContact;
 use super::settings::MillingtonSettings;
 use super::velocity::{reopen_friction, resolve_velocity, update_velocity, velocity_key};
 use super::worst_first::Pass;
 use crate::SolverBody;
 
-/// The position pass: worst = deepest penetration.
+/// The position pass: worst = deepest penetration, or the most a contact lifted clear may
+/// take back of its own projection ([`position_key`]).
 pub(crate) struct PositionPass<'a> {
     pub(crate) contacts: &'a mut [PreparedContact],
     pub(crate) bodies: &'a mut [SolverBody],
@@ -21,14 +22,18 @@ impl Pass for PositionPass<'_> {
     fn key(&self, contact: u32) -> f32 {
         let p = &self.contacts[contact as usize];
         if resolvable(p, self.settings.projection) {
-            p.penetration
+            position_key(p, self.settings.relaxation)
         } else {
             f32::NEG_INFINITY
         }
     }
 
     fn resolve(&mut self, contact: u32) -> Option<BodyChange> {
-        resolve_penetration(&self.contacts[contact as usize], self.bodies, self.settings)
+        resolve_penetration(
+            &mut self.contacts[contact as usize],
+            self.bodies,
+            self.settings,
+        )
     }
 
     #[inline]

@@ -27,8 +27,34 @@ pub struct PenetrationMoves {
     pub rotation: [Vec3; 2],
 }
 
+/// The penetration (m) a pick of `p` resolves: `relaxation · penetration`, with the contact's
+/// total over the step ([`PreparedContact::projected`]) kept ≥ 0. A contact that a
+/// neighbour's projection has since lifted clear (negative penetration) takes back part of
+/// its own earlier push, never more: the points of one face then share the push as the
+/// geometry asks. Projected one after the other without it, the first of an edge's two
+/// points tipped the body onto the second, whose projection then tipped the first clear, and
+/// the first could not give anything back (the lecture's cube ended turned about its edge).
+#[inline]
+pub fn projection_depth(p: &PreparedContact, relaxation: f32) -> f32 {
+    (p.projected + p.penetration * relaxation).max(0.0) - p.projected
+}
+
+/// What a pick of `p` would resolve, as the position pass ranks it (m): the penetration
+/// while there is one, else how far the contact may still back off towards touching
+/// (|penetration|, at most its accumulated projection over the relaxation); for a clear
+/// contact with nothing to take back, its (negative) penetration.
+#[inline]
+pub fn position_key(p: &PreparedContact, relaxation: f32) -> f32 {
+    if p.penetration >= 0.0 || !(p.projected > 0.0) || !(relaxation > 0.0) {
+        p.penetration
+    } else {
+        (-p.penetration).min(p.projected / relaxation)
+    }
+}
+
 /// The nonlinear projection of `p` (lecture method 3 with relaxation, method 4): the resolved
-/// penetration `relaxation · penetration` is shared between the linear inertia 1/m and the
+/// penetration ([`projection_depth`]: `relaxation · penetration` on a contact's first pick)
+/// is shared between the linear inertia 1/m and the
 /// angular inertia ((I⁻¹(r×n))×r)·n of each moving side; each angular move is limited to
 /// `angular_limit · |r − (r·n)n|` and the excess given to the linear move (Cyclone's limit,
 /// the lecture's "scale the angular move by the size of the object").
@@ -55,7 +81,7 @@ pub fn nonlinear_moves(
     if !(total > 0.0) {
         return None;
     }
-    let depth = p.penetration * relaxation;
+    let depth = projection_depth(p, relaxation);
     let mut moves = PenetrationMoves::default();
     for side in 0..2 {
         let Some(b) = p.side_body(bodies, side) else {
@@ -82,7 +108,8 @@ pub fn nonlinear_moves(
     Some(moves)
 }
 
-/// The linear projection of `p` (lecture method 1, with relaxation): both sides translate
+/// The linear projection of `p` (lecture method 1, with relaxation; the depth of
+/// [`projection_depth`]): both sides translate
 /// along the normal in proportion to their inverse masses; nothing rotates. `None` when
 /// neither side can translate.
 pub fn linear_moves(
@@ -94,7 +121,7 @@ pub fn linear_moves(
     if !(total > 0.0) {
         return None;
     }
-    let depth = p.penetration * relaxation;
+    let depth = projection_depth(p, relaxation);
     let n = p.normal();
     let mut moves = PenetrationMoves::default();
     for side in 0..2 {
@@ -158,11 +185,12 @@ pub fn apply_moves(
 }
 
 /// Resolves the penetration of `p` with the projection chosen in `settings` and moves the
-/// bodies. `p.penetration` itself is **not** updated here; the pass updates it like any other
+/// bodies, adding the depth resolved to `p.projected` ([`projection_depth`]).
+/// `p.penetration` itself is **not** updated here; the pass updates it like any other
 /// contact sharing a body ([`update_penetration`]), as Cyclone does. `None` when nothing can
 /// move.
 pub fn resolve_penetration(
-    p: &PreparedContact,
+    p: &mut PreparedContact,
     bodies: &mut [SolverBody],
     settings: &MillingtonSettings,
 ) -> Option<BodyChange> {
@@ -172,6 +200,7 @@ pub fn resolve_penetration(
         }
         Projection::Linear => linear_moves(p, bodies, settings.relaxation),
     }?;
+    p.projected += projection_depth(p, settings.relaxation);
     Some(apply_moves(p, &moves, bodies))
 }
 

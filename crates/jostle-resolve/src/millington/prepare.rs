@@ -79,6 +79,11 @@ pub struct PreparedContact {
     /// The sliding velocity (contact space, x = 0) right after the pick that saturated the
     /// contact; meaningful only while `friction_saturated`.
     pub saturated_sliding: Vec3,
+    /// Penetration (m, ≥ 0) this contact's own picks have resolved so far this step: the sum
+    /// of their projection depths. A pick may take back part of it, never more
+    /// ([`super::position::projection_depth`]): the position pass's accumulated clamp, as the
+    /// velocity pass clamps `impulse`.
+    pub projected: f32,
 }
 
 impl PreparedContact {
@@ -130,6 +135,7 @@ impl PreparedContact {
             impulse: Vec3::ZERO,
             friction_saturated: false,
             saturated_sliding: Vec3::ZERO,
+            projected: 0.0,
         }
     }
 
@@ -311,6 +317,7 @@ pub fn prepare(
         impulse: Vec3::ZERO,
         friction_saturated: false,
         saturated_sliding: Vec3::ZERO,
+        projected: 0.0,
     })
 }
 
