@@ -84,6 +84,10 @@ pub struct PreparedContact {
     /// ([`super::position::projection_depth`]): the position pass's accumulated clamp, as the
     /// velocity pass clamps `impulse`.
     pub projected: f32,
+    /// Warm started ([`super::MillingtonSettings::warm_start`]): a resting contact that
+    /// applied its carried impulse before the first pick. Its target stays for the step
+    /// (picks of other pairs do not decide it again, [`super::velocity::update_velocity`]).
+    pub held: bool,
 }
 
 impl PreparedContact {
@@ -136,6 +140,7 @@ impl PreparedContact {
             friction_saturated: false,
             saturated_sliding: Vec3::ZERO,
             projected: 0.0,
+            held: false,
         }
     }
 
@@ -318,6 +323,7 @@ pub fn prepare(
         friction_saturated: false,
         saturated_sliding: Vec3::ZERO,
         projected: 0.0,
+        held: false,
     })
 }
 

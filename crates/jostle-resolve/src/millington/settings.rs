@@ -158,6 +158,17 @@ pub struct MillingtonSettings {
     pub projection: Projection,
     /// How the worst contact is found. Default [`PickStrategy::Heap`]; results are identical.
     pub pick: PickStrategy,
+    /// Start the velocity pass from the impulses the contacts carried from the previous step
+    /// (the narrow phase matches them by feature id): every resting contact (closing slower
+    /// than `velocity_limit`) applies its carried impulse, clamped to a push and to its
+    /// friction cone, before the first pick, and keeps its target (touching, or closing its
+    /// gap) for the whole step, taking back what its neighbours' picks make too much.
+    /// Default false (see [`MillingtonResolver`](super::MillingtonResolver)).
+    pub warm_start: bool,
+    /// Both passes first resolve every contact once, in order, before they pick worst-first
+    /// (the lecture: "run through the entire list once, then prioritise"), out of the same
+    /// budget. Default false.
+    pub first_sweep: bool,
 }
 
 impl MillingtonSettings {
@@ -255,6 +266,8 @@ impl Default for MillingtonSettings {
             relaxation: 1.0,
             projection: Projection::Nonlinear,
             pick: PickStrategy::Heap,
+            warm_start: false,
+            first_sweep: false,
         }
     }
 }

@@ -430,7 +430,7 @@ pub fn update_velocity(p: &mut PreparedContact, change: &BodyChange, velocity_li
     }
     if touched {
         let same_pair = change.body == p.body || change.body == [p.body[1], p.body[0]];
-        if !same_pair {
+        if !same_pair && !p.held {
             // A new collision, or nothing to do: what the other pair's pick left is kept
             // unless the micro-collision rule wants a push.
             let desired = desired_delta_velocity(

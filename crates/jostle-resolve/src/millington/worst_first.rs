@@ -211,9 +211,53 @@ pub(crate) fn run_linear_scan<P: Pass>(
     picks
 }
 
+/// The lecture's first pass ("run through the entire list once, then prioritise"): every
+/// contact of the island whose key is above `epsilon` when its turn comes is resolved once,
+/// in index order, and its neighbours updated, within `budget` picks. Returns the picks made.
+pub(crate) fn sweep<P: Pass>(
+    pass: &mut P,
+    island: &[u32],
+    islands: &Islands,
+    scratch: &mut PickScratch,
+    epsilon: f32,
+    budget: u32,
+) -> u32 {
+    let mut picks = 0;
+    let mut updates = 0;
+    for &c in island {
+        if picks >= budget {
+            break;
+        }
+        if !(pass.key(c) > epsilon) {
+            continue;
+        }
+        picks += 1;
+        let Some(change) = pass.resolve(c) else {
+            continue;
+        };
+        scratch.stamps.next();
+        for body in change.body {
+            for &n in islands.contacts_of(body) {
+                if scratch.stamps.mark(n) {
+                    pass.update(n, &change);
+                    updates += 1;
+                }
+            }
+        }
+    }
+    scratch.work += PickWork {
+        picks: u64::from(picks),
+        updates,
+        keys_read: island.len() as u64,
+        heap_moves: 0,
+    };
+    picks
+}
+
 /// Runs one pass over every island with the chosen pick strategy, each island with its own
-/// budget; returns the picks made, and leaves the largest key left in
-/// [`PickScratch::residual`].
+/// budget (with `first_sweep`, the lecture's first pass over every contact, [`sweep`],
+/// before the worst-first picks, out of the same budget); returns the picks made, and leaves
+/// the largest key left in [`PickScratch::residual`].
 pub(crate) fn run_islands<P: Pass>(
     pass: &mut P,
     islands: &Islands,
@@ -221,12 +265,18 @@ pub(crate) fn run_islands<P: Pass>(
     pick: super::settings::PickStrategy,
     budget: &super::settings::IterationBudget,
     epsilon: f32,
+    first_sweep: bool,
 ) -> u32 {
     let mut picks = 0;
     scratch.residual = 0.0;
     for i in 0..islands.len() {
         let island = islands.island(i);
-        let budget = budget.for_contacts(island.len());
+        let mut budget = budget.for_contacts(island.len());
+        if first_sweep {
+            let swept = sweep(pass, island, islands, scratch, epsilon, budget);
+            picks += swept;
+            budget -= swept;
+        }
         picks += match pick {
             super::settings::PickStrategy::Heap => {
                 run_heap(pass, island, islands, scratch, epsilon, budget)
