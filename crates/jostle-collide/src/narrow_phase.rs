@@ -264,6 +264,9 @@ pub struct NarrowPhase {
     /// otherwise [`NarrowPhase::find_force_events`] has nothing to look at.
     #[cfg_attr(feature = "serde", serde(skip))]
     any_threshold: bool,
+    /// Scratch: a recomputed pair's points before the update ([`compute`]).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    old_points_scratch: Vec<(PointKey, PointData)>,
 }
 
 impl std::fmt::Debug for NarrowPhase {
@@ -679,6 +682,7 @@ impl NarrowPhase {
         overlaps.clear();
         self.any_threshold = false;
 
+        let mut old_points = std::mem::take(&mut self.old_points_scratch);
         let mut old_pairs = std::mem::replace(&mut self.pairs, std::mem::take(&mut self.spare));
         self.pairs.clear();
         self.pairs.reserve(pairs.len());
@@ -749,7 +753,7 @@ impl NarrowPhase {
                     .filter(|m| !m.points.is_empty())
                     .count();
             } else {
-                compute(&mut state, c1, c2, &pos12, prediction);
+                compute(&mut state, c1, c2, &pos12, prediction, &mut old_points);
             }
 
             self.any_threshold |=
@@ -830,6 +834,7 @@ impl NarrowPhase {
         }
         drop(old);
         self.spare = old_pairs;
+        self.old_points_scratch = old_points;
         stats.contact_points = self.contacts.len();
         self.update_events(touching, bodies);
         self.update_sensor_events(overlaps, colliders, bodies);
@@ -994,19 +999,27 @@ fn manifold_pos12(m: &Manifold, pos12: &Pose) -> Pose {
     sub1.inv_mul(&(pos12 * sub2))
 }
 
+/// A contact point's identity across recomputations: its sub-shapes and feature ids.
+type PointKey = (u32, u32, PackedFeatureId, PackedFeatureId);
+
 /// Recomputes a pair's manifolds with parry, reduces each to four points and carries the
 /// impulses over by feature id.
-fn compute(state: &mut PairState, c1: &Collider, c2: &Collider, pos12: &Pose, prediction: f32) {
-    type Key = (u32, u32, PackedFeatureId, PackedFeatureId);
-    let old: Vec<(Key, PointData)> = state
-        .manifolds
-        .iter()
-        .flat_map(|m| {
-            m.points
-                .iter()
-                .map(move |p| ((m.subshape1, m.subshape2, p.fid1, p.fid2), p.data))
-        })
-        .collect();
+/// `old` is scratch for the pair's points before the update, kept by the caller so that no
+/// recomputed pair allocates.
+fn compute(
+    state: &mut PairState,
+    c1: &Collider,
+    c2: &Collider,
+    pos12: &Pose,
+    prediction: f32,
+    old: &mut Vec<(PointKey, PointData)>,
+) {
+    old.clear();
+    old.extend(state.manifolds.iter().flat_map(|m| {
+        m.points
+            .iter()
+            .map(move |p| ((m.subshape1, m.subshape2, p.fid1, p.fid2), p.data))
+    }));
     let result = DefaultQueryDispatcher.contact_manifolds(
         pos12,
         &*c1.shape.0,
