@@ -107,6 +107,25 @@ impl PickScratch {
     }
 }
 
+/// Calls `f` once for every contact that shares a body with `change`, in the adjacency's
+/// order (a contact on both changed bodies once).
+#[inline]
+fn for_each_neighbour(
+    islands: &Islands,
+    stamps: &mut Stamps,
+    change: &BodyChange,
+    mut f: impl FnMut(u32),
+) {
+    stamps.next();
+    for body in change.body {
+        for &c in islands.contacts_of(body) {
+            if stamps.mark(c) {
+                f(c);
+            }
+        }
+    }
+}
+
 /// Worst-first over one island with the indexed heap. Returns the number of picks made.
 pub(crate) fn run_heap<P: Pass>(
     pass: &mut P,
@@ -138,16 +157,11 @@ pub(crate) fn run_heap<P: Pass>(
             debug_assert!(false, "a contact with a finite key must be resolvable");
             break;
         };
-        stamps.next();
-        for body in change.body {
-            for &c in islands.contacts_of(body) {
-                if stamps.mark(c) {
-                    pass.update(c, &change);
-                    heap.set_key(c, pass.key(c));
-                    updates += 1;
-                }
-            }
-        }
+        for_each_neighbour(islands, stamps, &change, |c| {
+            pass.update(c, &change);
+            heap.set_key(c, pass.key(c));
+            updates += 1;
+        });
     }
     *work += PickWork {
         picks: u64::from(picks),
@@ -235,15 +249,10 @@ pub(crate) fn sweep<P: Pass>(
         let Some(change) = pass.resolve(c) else {
             continue;
         };
-        scratch.stamps.next();
-        for body in change.body {
-            for &n in islands.contacts_of(body) {
-                if scratch.stamps.mark(n) {
-                    pass.update(n, &change);
-                    updates += 1;
-                }
-            }
-        }
+        for_each_neighbour(islands, &mut scratch.stamps, &change, |n| {
+            pass.update(n, &change);
+            updates += 1;
+        });
     }
     scratch.work += PickWork {
         picks: u64::from(picks),

@@ -412,8 +412,7 @@ wide_kernel! {
 /// 10⁻⁴·r of the exact projection while K's eigenvalues differ by up to five times (a box's
 /// corner: about 2.2) and within 3·10⁻²·r at thirty times (unit test
 /// `disk_projection_matches_the_exact_one`). Each further iteration costs about 2.5% of a
-/// resting pyramid's resolve stage (benches/RESULTS.md, "Friction's disk projection from a
-/// lower bound").
+/// resting pyramid's resolve stage (benches/RESULTS.md, "A cheaper relax pass").
 const DISK_PROJECTION_ITERATIONS: usize = 2;
 
 /// Friction for one point of eight lanes: both tangents at once with the 2×2 effective mass
@@ -533,11 +532,26 @@ fn accumulate_normal<F: Lane, L: LinearResponse<F>>(
     p: &mut PointLanes<F>,
     delta: F,
 ) {
+    let delta = clamp_normal(p, delta);
+    pair.apply_normal(p, delta);
+}
+
+/// Adds `delta` to the point's accumulated normal impulse, clamped so that the total never
+/// pulls (≥ 0); returns the change that remains, for the caller to apply.
+#[inline(always)]
+fn clamp_normal<F: Lane>(p: &mut PointLanes<F>, delta: F) -> F {
     let total = (p.normal_impulse + delta).max(F::ZERO);
     let delta = total - p.normal_impulse;
     p.normal_impulse = total;
     p.max_normal_impulse = p.max_normal_impulse.max(delta);
-    pair.apply_normal(p, delta);
+    delta
+}
+
+/// A speculative point's gap rule as a bias (m/s): it may close at most its gap `s` (> 0)
+/// within the substep; zero for a touching or overlapping point.
+#[inline(always)]
+fn gap_bias<F: Lane>(s: F, inv_h: F) -> F {
+    F::select(s.cmpgt(F::ZERO), s * inv_h, F::ZERO)
 }
 
 /// One rigid, unbiased normal row (a speculative point keeps its gap rule: it may close at
@@ -573,9 +587,8 @@ fn rigid_residual<F: Lane, L: LinearResponse<F>>(
     s: F,
     inv_h: F,
 ) -> F {
-    let bias = F::select(s.cmpgt(F::ZERO), s * inv_h, F::ZERO);
     let vn = pair.relative_velocity(p).dot(p.normal);
-    vn + bias
+    vn + gap_bias(s, inv_h)
 }
 
 /// Which pass a row of [`row_residuals`] is taken in.
@@ -889,13 +902,8 @@ fn relax_point<F: Lane, L: LinearResponse<F>>(
         return;
     }
     let dv = pair.relative_velocity(p);
-    let s = p.separation;
-    let bias = F::select(s.cmpgt(F::ZERO), s * inv_h, F::ZERO);
-    let delta = -p.normal_mass * (dv.dot(p.normal) + bias);
-    let total = (p.normal_impulse + delta).max(F::ZERO);
-    let dn = total - p.normal_impulse;
-    p.normal_impulse = total;
-    p.max_normal_impulse = p.max_normal_impulse.max(dn);
+    let delta = -p.normal_mass * (dv.dot(p.normal) + gap_bias(p.separation, inv_h));
+    let dn = clamp_normal(p, delta);
     let [c1, c2] = p.normal_tangent;
     let vt1 = dv.dot(p.tangent1) + dn * c1;
     let vt2 = dv.dot(p.tangent2) + dn * c2;
