@@ -887,9 +887,8 @@ fn relax_block<F: Lane, L: LinearResponse<F>>(
 
 /// One point of a single relax sweep: its normal row, then its friction. Friction's
 /// tangential velocity is the normal row's, plus what the normal impulse just changed
-/// ([`PointLanes::normal_tangent`]), and both impulses are applied at once: the point's
-/// chain of dependent operations is a third shorter than with the relative velocity
-/// computed again.
+/// ([`PointLanes::normal_tangent`]), and both impulses are applied at once: no second
+/// relative velocity waits between the normal impulse and friction's.
 #[inline(always)]
 fn relax_point<F: Lane, L: LinearResponse<F>>(
     m: &ManifoldLanes<F>,
