@@ -141,6 +141,11 @@ pub struct ManifoldLanes<F = F8> {
     /// [`ManifoldLanes::inv_mass_a`] axis by axis, otherwise through its x component alone
     /// (which is 0 for a body locked along every axis, as its other components are).
     pub locked: bool,
+    /// Lanes (bit l for lane l) whose body A keeps its warm start point by point in every
+    /// substep ([`super::body_state::EXACT_WARM`]); set after packing.
+    pub exact_a: u8,
+    /// The same for body B.
+    pub exact_b: u8,
     /// The Cholesky factor L of the batch's block system K + ε·diag(K) over its points
     /// ([`super::solve::factor_blocks`], for the block relax): L's entries below the
     /// diagonal row by row (l₁₀, l₂₀, l₂₁, l₃₀, l₃₁, l₃₂), then 1/lᵢᵢ for i = 0..4.
@@ -436,6 +441,8 @@ impl Batches {
             count,
             friction,
             locked: false,
+            exact_a: 0,
+            exact_b: 0,
             block: [F8::ZERO; BLOCK_ENTRIES],
         });
     }

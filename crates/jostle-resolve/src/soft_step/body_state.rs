@@ -24,6 +24,14 @@ pub type PseudoRow = [f32; 8];
 /// substeps at once after them.
 pub const FREE: u32 = 1 << 8;
 
+/// Flag of a [`BodyState`]: the body touches a body whose mass differs from its own by
+/// [`super::EXACT_WARM_RATIO`] or more, so its warm start is applied point by point in every
+/// substep instead of carried ([`super::integrate::Carried`]). Its velocity passes through
+/// values far larger than its own change while the rows of the heavy side act on it (at
+/// 1:10⁶, 10⁴ m/s for a change of 10⁻² m/s), and the rounding of those values would enter the
+/// carried change and be applied again in every later substep.
+pub const EXACT_WARM: u32 = 1 << 9;
+
 /// Hot state of one body during a soft step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]

@@ -393,6 +393,80 @@ fn warm_start_impl<F: Lane>(
     );
 }
 
+/// The warm start of a substep after the first for the bodies that keep it point by point
+/// ([`super::body_state::EXACT_WARM`]): in each batch with such a lane, every point's
+/// accumulated impulse applied to the flagged side of each lane only (the other bodies carry
+/// theirs: [`super::integrate::Carried`]).
+#[inline(always)]
+fn warm_start_exact_impl<F: Lane>(
+    manifolds: &[ManifoldLanes<F>],
+    points: &mut [PointLanes<F>],
+    base: u32,
+    states: &[Shared<BodyState>],
+) {
+    for m in manifolds.iter() {
+        if m.exact_a | m.exact_b == 0 {
+            continue;
+        }
+        let first = (m.first - base) as usize;
+        let points = &points[first..first + m.count as usize];
+        if m.locked {
+            let mut pair = Pair::load_axes(m, states);
+            warm_start_sides(m, &mut pair, points);
+            pair.store(m, states);
+        } else {
+            let mut pair = Pair::load_plain(m, states);
+            warm_start_sides(m, &mut pair, points);
+            pair.store(m, states);
+        }
+    }
+}
+
+/// 1 in the lanes whose bit is set in `bits`, else 0.
+#[inline(always)]
+fn lane_ones<F: Lane>(bits: u8) -> F {
+    let mut ones = [0.0; LANES];
+    for (lane, one) in ones.iter_mut().enumerate() {
+        if bits >> lane & 1 == 1 {
+            *one = 1.0;
+        }
+    }
+    F::from_array(ones)
+}
+
+/// [`warm_start_exact_impl`] for one batch: each point's accumulated impulse on side A in
+/// the lanes of [`ManifoldLanes::exact_a`], on side B in those of
+/// [`ManifoldLanes::exact_b`].
+#[inline(always)]
+fn warm_start_sides<F: Lane, L: LinearResponse<F>>(
+    m: &ManifoldLanes<F>,
+    pair: &mut Pair<F, L>,
+    points: &[PointLanes<F>],
+) {
+    let (on_a, on_b) = (lane_ones::<F>(m.exact_a), lane_ones::<F>(m.exact_b));
+    // The operations of `warm_start_impl`, lane-masked by side.
+    for p in points {
+        let (na, nb) = (p.normal_impulse * on_a, p.normal_impulse * on_b);
+        pair.a.linear += pair.inv_mass_a.times(p.normal * na);
+        pair.a.angular += p.ang_a_normal * na;
+        pair.b.linear -= pair.inv_mass_b.times(p.normal * nb);
+        pair.b.angular -= p.ang_b_normal * nb;
+        if m.friction {
+            let [t1, t2] = p.tangent_impulse;
+            let (t1a, t2a, t1b, t2b) = (t1 * on_a, t2 * on_a, t1 * on_b, t2 * on_b);
+            pair.a.linear += pair.inv_mass_a.times(p.tangent1 * t1a + p.tangent2 * t2a);
+            pair.a.angular += p.ang_a_tangent1 * t1a + p.ang_a_tangent2 * t2a;
+            pair.b.linear -= pair.inv_mass_b.times(p.tangent1 * t1b + p.tangent2 * t2b);
+            pair.b.angular -= p.ang_b_tangent1 * t1b + p.ang_b_tangent2 * t2b;
+        }
+    }
+}
+
+wide_kernel! {
+    /// [`warm_start_exact_impl`] over some batches.
+    pub(crate) fn warm_start_exact_range() = warm_start_exact_impl;
+}
+
 /// Applies every contact's accumulated impulse (the previous substep's, or on the first
 /// substep the previous step's): the solver then only corrects what changed.
 pub fn warm_start(batches: &mut Batches, states: &mut [BodyState]) {
