@@ -558,34 +558,26 @@ fn project_to_disk<F: Lane>(inv_k: [F; 3], target: [F; 2], r: F, over: F::Mask) 
     let target_len = (target[0] * target[0] + target[1] * target[1]).sqrt();
     let start = k_min * (target_len * inv_r - F::ONE);
     let mut nu = F::select(start.is_finite_mask(), start.max(F::ZERO), F::ZERO);
+    // Newton on ψ(ν) = 1/|λ(ν)| − 1/r, ψ'(ν) = −(λ·dλ/dν)/|λ|³ with dλ/dν = −(K + νI)⁻¹·λ,
+    // written in u = adj(K + νI)·b = det·λ (det = det(K + νI) > 0), where the determinant
+    // cancels: ν ← ν − |u|²·(det − |u|/r) / (uᵀ·adj(K + νI)·u). One division and one square
+    // root per step (the same step as in λ, which takes three divisions), and the point on
+    // the circle is u·r/|u|.
     for _ in 0..DISK_PROJECTION_ITERATIONS {
         let (m11, m22) = (k11 + nu, k22 + nu);
-        let inv_det = (m11 * m22 - k12 * k12).recip();
-        let lambda = [
-            (m22 * rhs1 - k12 * rhs2) * inv_det,
-            (m11 * rhs2 - k12 * rhs1) * inv_det,
-        ];
-        // dλ/dν = −(K + νI)⁻¹·λ.
-        let d = [
-            -(m22 * lambda[0] - k12 * lambda[1]) * inv_det,
-            -(m11 * lambda[1] - k12 * lambda[0]) * inv_det,
-        ];
-        let len_sq = lambda[0] * lambda[0] + lambda[1] * lambda[1];
-        let len = len_sq.sqrt();
-        // ψ(ν) = 1/|λ| − 1/r, ψ'(ν) = −(λ·dλ/dν)/|λ|³.
-        let psi = len.recip() - inv_r;
-        let dpsi = -(lambda[0] * d[0] + lambda[1] * d[1]) / (len_sq * len);
-        nu = (nu - psi / dpsi).max(F::ZERO);
+        let det = m11 * m22 - k12 * k12;
+        let u = [m22 * rhs1 - k12 * rhs2, m11 * rhs2 - k12 * rhs1];
+        let u_sq = u[0] * u[0] + u[1] * u[1];
+        let adj_u = [m22 * u[0] - k12 * u[1], m11 * u[1] - k12 * u[0]];
+        let w = u[0] * adj_u[0] + u[1] * adj_u[1];
+        // |u|²/w (about 1/K) before the product, which keeps it within f32's range.
+        nu = (nu - u_sq / w * (det - u_sq.sqrt() * inv_r)).max(F::ZERO);
     }
     let (m11, m22) = (k11 + nu, k22 + nu);
-    let inv_det = (m11 * m22 - k12 * k12).recip();
-    let lambda = [
-        (m22 * rhs1 - k12 * rhs2) * inv_det,
-        (m11 * rhs2 - k12 * rhs1) * inv_det,
-    ];
+    let u = [m22 * rhs1 - k12 * rhs2, m11 * rhs2 - k12 * rhs1];
     // Exactly onto the circle; the Newton result is already there to rounding.
-    let len = (lambda[0] * lambda[0] + lambda[1] * lambda[1]).sqrt();
-    let projected = [lambda[0] * (r / len), lambda[1] * (r / len)];
+    let len = (u[0] * u[0] + u[1] * u[1]).sqrt();
+    let projected = [u[0] * (r / len), u[1] * (r / len)];
     let scaled = [target[0] * (r / target_len), target[1] * (r / target_len)];
     let usable = invertible
         & len.cmpgt(F::ZERO)
