@@ -572,12 +572,27 @@ pub const PRELOAD_MIN_DAMPING: f32 = 0.25;
 /// moves more than this fraction of [`SoftStepSettings::preload_target`] per step.
 const PRELOAD_REST: f32 = 0.1;
 
+/// A manifold's preload is held while its mean overlap lies between `target` and this
+/// fraction of `target` below it ([`preload_update`]).
+///
+/// Integrated every step, the preload follows the noise of its manifold's overlap around the
+/// target for as long as the manifold rests, and a box resting on two supports then gets two
+/// preloads that wander apart: integral action on the pile's slow lateral modes. Measured on
+/// the 60-row pyramid over 60 s (`FAMILY_SECONDS=60`, the exact start and four perturbed ones):
+/// integrated every step it creeps 9.4–11.9 mm, steadily; held in this band 3.7–8.2 mm; with
+/// no preload at all 2.9–4.9 mm, but sinking 1.03–1.12 mm per layer. A band on both sides of
+/// the target (±0.5 × `target`) stopped the creep as well (3.7–5.1 mm) but let the springs rest
+/// up to half a target deeper, softer under load: the 60-box column swayed 16.4 mm in 20 s
+/// instead of 8.5 (benches/RESULTS.md, "The preload held at rest").
+const PRELOAD_HOLD: f32 = 0.5;
+
 /// The next preload of a manifold's points ([`SoftStepSettings::preload_rate`]).
 ///
 /// While the manifold carries a load and is at rest (no point closing or opening faster than
 /// [`PRELOAD_REST`] × `target` per step at the start of the step), `rate` times its mean
-/// overlap beyond `target` at the end of the step is added to its mean preload, never below 0;
-/// while it moves the preload is held. Never above the static compression of its springs under
+/// overlap beyond `target` at the end of the step is added to its mean preload, never below 0,
+/// unless that overlap is within [`PRELOAD_HOLD`] × `target` below `target`: there, as while
+/// it moves, the preload is held. Never above the static compression of its springs under
 /// its load (`compression`), so the preload never asks more of a spring than its load does.
 /// Unloaded, or with the rate 0, the preload is 0.
 ///
@@ -590,10 +605,12 @@ fn preload_update(manifold: solve::ManifoldEnd, rate: f32, target: f32, dt: f32)
     if !(rate > 0.0 && manifold.normal_impulse > 0.0) {
         return 0.0;
     }
-    let preload = if manifold.speed * dt > PRELOAD_REST * target {
+    let error = manifold.penetration - target;
+    let held = error <= 0.0 && error >= -PRELOAD_HOLD * target;
+    let preload = if manifold.speed * dt > PRELOAD_REST * target || held {
         manifold.preload
     } else {
-        manifold.preload + rate * (manifold.penetration - target)
+        manifold.preload + rate * error
     };
     preload.min(manifold.compression).max(0.0)
 }

@@ -135,8 +135,10 @@ pub struct SoftStepSettings {
     /// 4.1 mm for 60, 43 mm under a box 1,000 times heavier). With a rate r > 0 every loaded
     /// manifold learns a preload ([`crate::Contact::preload`]), one value for all its points:
     /// at the end of each step in which it is at rest, r times its mean overlap beyond
-    /// `preload_target` is added to it (a shortfall takes it down; never below 0, never above
-    /// its springs' static compression under their load), and each of its points' springs
+    /// `preload_target` is added to it (a shortfall of more than half the target takes it
+    /// down; within that it is held, so a manifold at rest stops integrating the noise of its
+    /// overlap; never below 0, never above its springs' static compression under their
+    /// load), and each of its points' springs
     /// acts as if compressed by that much more, growing in over the first `preload_target` of
     /// overlap. A loaded manifold then rests near `preload_target` whatever its load, after a
     /// few seconds. How much the preload may stiffen a spring is bounded by the load it
