@@ -683,157 +683,57 @@ impl NarrowPhase {
         self.any_threshold = false;
 
         let mut old_points = std::mem::take(&mut self.old_points_scratch);
-        let mut old_pairs = std::mem::replace(&mut self.pairs, std::mem::take(&mut self.spare));
-        self.pairs.clear();
-        self.pairs.reserve(pairs.len());
-        let mut old = old_pairs.drain(..).peekable();
-        for &pair in pairs.iter() {
-            while old.next_if(|s| s.pair < pair).is_some() {}
-            let mut state = old
-                .next_if(|s| s.pair == pair)
-                .unwrap_or_else(|| PairState::new(pair));
-            let (Some(c1), Some(c2)) = (colliders.get(pair.0), colliders.get(pair.1)) else {
-                continue;
-            };
-            let (Some(b1), Some(b2)) = (bodies.get(c1.body), bodies.get(c2.body)) else {
-                continue;
-            };
-            let pose1 = c1.world_pose(b1);
-            let pose2 = c2.world_pose(b2);
-            if !(pose1.is_finite() && pose2.is_finite()) {
-                // Non-finite state is the facade's to report; it must not reach parry.
-                continue;
-            }
-            if !c1.groups.meets(&c2.groups) || filter.is_some_and(|f| !f(c1, c2)) {
-                continue;
-            }
-            let pos12 = pose1.inv_mul(&pose2);
-            if c1.sensor || c2.sensor {
-                // No contact: only whether they overlap (an unsupported pair of shapes never
-                // does).
-                let overlapping = parry3d::query::intersection_test(
-                    &Pose::IDENTITY,
-                    c1.shape.as_ref(),
-                    &pos12,
-                    c2.shape.as_ref(),
-                )
-                .is_ok_and(|i| i.intersecting);
-                if overlapping {
-                    overlaps.push(if c1.sensor {
-                        (pair.0, pair.1)
-                    } else {
-                        (pair.1, pair.0)
-                    });
-                }
-                continue;
-            }
-            let material = Material::mix(c1.material, c2.material);
-            let prediction = pair_prediction(
-                c1,
-                b1,
-                c2,
-                b2,
-                settings.prediction,
-                dt,
-                material.restitution,
-            );
-            if reusable(
-                &state,
-                &pos12,
-                (shape_id(c1), shape_id(c2)),
-                settings,
-                prediction,
-            ) {
-                for m in &mut state.manifolds {
-                    m.update_separations(&manifold_pos12(m, &pos12));
-                }
-                stats.manifolds_reused += state
-                    .manifolds
-                    .iter()
-                    .filter(|m| !m.points.is_empty())
-                    .count();
-            } else {
-                compute(&mut state, c1, c2, &pos12, prediction, &mut old_points);
-            }
-
-            self.any_threshold |=
-                c1.force_event_threshold.is_some() || c2.force_event_threshold.is_some();
-            // A is the dynamic body when the other is fixed or kinematic; else collider 1's body.
-            let flip = b1.is_immovable() && !b2.is_immovable();
-            let (a, b) = if flip {
-                (c2.body, c1.body)
-            } else {
-                (c1.body, c2.body)
-            };
-            let (body_a, body_b) = if flip { (b2, b1) } else { (b1, b2) };
-            let pair_index = self.pairs.len() as u32;
-            let mut touches = false;
-            for (mi, m) in state.manifolds.iter_mut().enumerate() {
-                let w1 = m.subshape_pos1().map_or(pose1, |sub| pose1 * sub);
-                let w2 = m.subshape_pos2().map_or(pose2, |sub| pose2 * sub);
-                // parry's normal points out of shape 1, toward shape 2.
-                let Some(n1) = (w1.rotation * m.local_n1).try_normalize() else {
-                    continue;
-                };
-                if m.points.is_empty() {
-                    continue;
-                }
-                stats.manifolds += 1;
-                let normal = if flip { n1 } else { -n1 };
-                for (pi, pt) in m.points.iter_mut().enumerate() {
-                    let p1 = w1 * pt.local_p1;
-                    let p2 = w2 * pt.local_p2;
-                    touches |= pt.dist <= 0.0;
-                    // Each body's lever arm ends on its own surface: from the midpoint, a deep
-                    // contact's lever arm could reach outside a thin body and spin it about
-                    // its axis (a 0.09 m cylinder 1 m inside a capsule gained 42% of its
-                    // energy in one step).
-                    let (on_a, on_b) = if flip { (p2, p1) } else { (p1, p2) };
-                    if pt.dist > settings.prediction {
-                        // Beyond the prediction distance only what closes within the step.
-                        let closing = (body_b.linear_velocity
-                            + body_b.angular_velocity.cross(on_b - body_b.position)
-                            - body_a.linear_velocity
-                            - body_a.angular_velocity.cross(on_a - body_a.position))
-                        .dot(normal);
-                        if pt.dist > settings.prediction + closing.max(0.0) * dt {
-                            continue;
-                        }
-                    }
-                    let fresh = Frame {
-                        normal,
-                        r_a: on_a - body_a.position,
-                        r_b: on_b - body_b.position,
-                    };
-                    let frame =
-                        Frame::hold(&mut pt.data.frame, fresh, settings.frame_tolerance, min_cos);
-                    self.contacts.push(BodyContact {
-                        a,
-                        b,
-                        point: body_a.position + frame.r_a,
-                        point_b: body_b.position + frame.r_b,
-                        normal: frame.normal,
-                        penetration: -pt.dist,
-                        friction: material.friction,
-                        dynamic_friction: material.dynamic_friction,
-                        restitution: material.restitution,
-                        impulse: pt.data.impulse,
-                        preload: pt.data.preload,
-                    });
-                    self.slots.push(PointSlot {
-                        pair: pair_index,
-                        manifold: mi as u32,
-                        point: pi as u32,
-                    });
+        let mut out = PairOutputs {
+            contacts: &mut self.contacts,
+            slots: &mut self.slots,
+            touching: &mut touching,
+            overlaps: &mut overlaps,
+            any_threshold: &mut self.any_threshold,
+            stats: &mut stats,
+            old_points: &mut old_points,
+            min_cos,
+        };
+        let input = PairInputs {
+            colliders,
+            bodies,
+            settings,
+            filter,
+            dt,
+        };
+        let same_pairs = self.pairs.len() == pairs.len()
+            && self
+                .pairs
+                .iter()
+                .zip(pairs.iter())
+                .all(|(s, p)| s.pair == *p);
+        if same_pairs {
+            // The broad phase's pairs are last update's: each state is updated where it is
+            // (moving every state into a new list cost a memmove per pair). The same calls in
+            // the same order as below, so the same results.
+            let mut kept = 0u32;
+            self.pairs.retain_mut(|state| {
+                let keep = update_pair(state, kept, &input, &mut out);
+                kept += u32::from(keep);
+                keep
+            });
+        } else {
+            let mut old_pairs = std::mem::replace(&mut self.pairs, std::mem::take(&mut self.spare));
+            self.pairs.clear();
+            self.pairs.reserve(pairs.len());
+            let mut old = old_pairs.drain(..).peekable();
+            for &pair in pairs.iter() {
+                while old.next_if(|s| s.pair < pair).is_some() {}
+                let mut state = old
+                    .next_if(|s| s.pair == pair)
+                    .unwrap_or_else(|| PairState::new(pair));
+                let index = self.pairs.len() as u32;
+                if update_pair(&mut state, index, &input, &mut out) {
+                    self.pairs.push(state);
                 }
             }
-            if touches {
-                touching.push(ordered(c1.body, c2.body));
-            }
-            self.pairs.push(state);
+            drop(old);
+            self.spare = old_pairs;
         }
-        drop(old);
-        self.spare = old_pairs;
         self.old_points_scratch = old_points;
         stats.contact_points = self.contacts.len();
         self.update_events(touching, bodies);
@@ -897,6 +797,191 @@ impl NarrowPhase {
         });
         self.touching_scratch = std::mem::replace(&mut self.touching, touching);
     }
+}
+
+/// What [`update_pair`] reads: the world and the update's settings.
+#[derive(Clone, Copy)]
+struct PairInputs<'a> {
+    colliders: &'a ColliderSet,
+    bodies: &'a BodySet,
+    settings: &'a CollideSettings,
+    filter: Option<&'a PairFilter>,
+    /// The step (s), finite and ≥ 0.
+    dt: f32,
+}
+
+/// Where [`update_pair`] writes: the update's outputs and scratch.
+struct PairOutputs<'a> {
+    contacts: &'a mut Vec<BodyContact>,
+    slots: &'a mut Vec<PointSlot>,
+    touching: &'a mut Vec<(BodyHandle, BodyHandle)>,
+    overlaps: &'a mut Vec<(ColliderHandle, ColliderHandle)>,
+    any_threshold: &'a mut bool,
+    stats: &'a mut NarrowStats,
+    old_points: &'a mut Vec<(PointKey, PointData)>,
+    /// Cosine of [`CollideSettings::frame_angle_tolerance`].
+    min_cos: f32,
+}
+
+/// One pair's part of [`NarrowPhase::update_swept`]: its manifolds reused or recomputed and
+/// its contacts appended to `out`, as the pair at `pair_index` of the new pair list. Returns
+/// whether the pair's state is kept (false for a pair whose colliders or bodies are gone,
+/// whose state is not finite, or that its groups or the filter exclude, and for a sensor
+/// pair, which only records whether it overlaps).
+fn update_pair(
+    state: &mut PairState,
+    pair_index: u32,
+    input: &PairInputs<'_>,
+    out: &mut PairOutputs<'_>,
+) -> bool {
+    let PairInputs {
+        colliders,
+        bodies,
+        settings,
+        filter,
+        dt,
+    } = *input;
+    let (Some(c1), Some(c2)) = (colliders.get(state.pair.0), colliders.get(state.pair.1)) else {
+        return false;
+    };
+    let (Some(b1), Some(b2)) = (bodies.get(c1.body), bodies.get(c2.body)) else {
+        return false;
+    };
+    let pose1 = c1.world_pose(b1);
+    let pose2 = c2.world_pose(b2);
+    if !(pose1.is_finite() && pose2.is_finite()) {
+        // Non-finite state is the facade's to report; it must not reach parry.
+        return false;
+    }
+    if !c1.groups.meets(&c2.groups) || filter.is_some_and(|f| !f(c1, c2)) {
+        return false;
+    }
+    let pos12 = pose1.inv_mul(&pose2);
+    if c1.sensor || c2.sensor {
+        // No contact: only whether they overlap (an unsupported pair of shapes never
+        // does).
+        let overlapping = parry3d::query::intersection_test(
+            &Pose::IDENTITY,
+            c1.shape.as_ref(),
+            &pos12,
+            c2.shape.as_ref(),
+        )
+        .is_ok_and(|i| i.intersecting);
+        if overlapping {
+            out.overlaps.push(if c1.sensor {
+                (state.pair.0, state.pair.1)
+            } else {
+                (state.pair.1, state.pair.0)
+            });
+        }
+        return false;
+    }
+    let material = Material::mix(c1.material, c2.material);
+    let prediction = pair_prediction(
+        c1,
+        b1,
+        c2,
+        b2,
+        settings.prediction,
+        dt,
+        material.restitution,
+    );
+    if reusable(
+        state,
+        &pos12,
+        (shape_id(c1), shape_id(c2)),
+        settings,
+        prediction,
+    ) {
+        for m in &mut state.manifolds {
+            m.update_separations(&manifold_pos12(m, &pos12));
+        }
+        out.stats.manifolds_reused += state
+            .manifolds
+            .iter()
+            .filter(|m| !m.points.is_empty())
+            .count();
+    } else {
+        compute(state, c1, c2, &pos12, prediction, out.old_points);
+    }
+
+    *out.any_threshold |= c1.force_event_threshold.is_some() || c2.force_event_threshold.is_some();
+    // A is the dynamic body when the other is fixed or kinematic; else collider 1's body.
+    let flip = b1.is_immovable() && !b2.is_immovable();
+    let (a, b) = if flip {
+        (c2.body, c1.body)
+    } else {
+        (c1.body, c2.body)
+    };
+    let (body_a, body_b) = if flip { (b2, b1) } else { (b1, b2) };
+    let mut touches = false;
+    for (mi, m) in state.manifolds.iter_mut().enumerate() {
+        let w1 = m.subshape_pos1().map_or(pose1, |sub| pose1 * sub);
+        let w2 = m.subshape_pos2().map_or(pose2, |sub| pose2 * sub);
+        // parry's normal points out of shape 1, toward shape 2.
+        let Some(n1) = (w1.rotation * m.local_n1).try_normalize() else {
+            continue;
+        };
+        if m.points.is_empty() {
+            continue;
+        }
+        out.stats.manifolds += 1;
+        let normal = if flip { n1 } else { -n1 };
+        for (pi, pt) in m.points.iter_mut().enumerate() {
+            let p1 = w1 * pt.local_p1;
+            let p2 = w2 * pt.local_p2;
+            touches |= pt.dist <= 0.0;
+            // Each body's lever arm ends on its own surface: from the midpoint, a deep
+            // contact's lever arm could reach outside a thin body and spin it about
+            // its axis (a 0.09 m cylinder 1 m inside a capsule gained 42% of its
+            // energy in one step).
+            let (on_a, on_b) = if flip { (p2, p1) } else { (p1, p2) };
+            if pt.dist > settings.prediction {
+                // Beyond the prediction distance only what closes within the step.
+                let closing = (body_b.linear_velocity
+                    + body_b.angular_velocity.cross(on_b - body_b.position)
+                    - body_a.linear_velocity
+                    - body_a.angular_velocity.cross(on_a - body_a.position))
+                .dot(normal);
+                if pt.dist > settings.prediction + closing.max(0.0) * dt {
+                    continue;
+                }
+            }
+            let fresh = Frame {
+                normal,
+                r_a: on_a - body_a.position,
+                r_b: on_b - body_b.position,
+            };
+            let frame = Frame::hold(
+                &mut pt.data.frame,
+                fresh,
+                settings.frame_tolerance,
+                out.min_cos,
+            );
+            out.contacts.push(BodyContact {
+                a,
+                b,
+                point: body_a.position + frame.r_a,
+                point_b: body_b.position + frame.r_b,
+                normal: frame.normal,
+                penetration: -pt.dist,
+                friction: material.friction,
+                dynamic_friction: material.dynamic_friction,
+                restitution: material.restitution,
+                impulse: pt.data.impulse,
+                preload: pt.data.preload,
+            });
+            out.slots.push(PointSlot {
+                pair: pair_index,
+                manifold: mi as u32,
+                point: pi as u32,
+            });
+        }
+    }
+    if touches {
+        out.touching.push(ordered(c1.body, c2.body));
+    }
+    true
 }
 
 /// Walks two sorted, deduplicated lists together: `f(item, false)` for each item only in
