@@ -579,8 +579,9 @@ const PRELOAD_REST: f32 = 0.1;
 /// target for as long as the manifold rests, and a box resting on two supports then gets two
 /// preloads that wander apart: integral action on the pile's slow lateral modes. Measured on
 /// the 60-row pyramid over 60 s (`FAMILY_SECONDS=60`, the exact start and four perturbed ones):
-/// integrated every step it creeps 9.4–11.9 mm, steadily; held in this band 3.7–8.2 mm; with
-/// no preload at all 2.9–4.9 mm, but sinking 1.03–1.12 mm per layer. A band on both sides of
+/// integrated every step it creeps 9.4–11.9 mm, steadily; held in this band 3.7–8.2 mm (and
+/// 7.5 and 10.2 mm from the family's two seeded starts); with no preload at all 2.9–4.9 mm,
+/// but sinking 1.03–1.12 mm per layer. A band on both sides of
 /// the target (±0.5 × `target`) stopped the creep as well (3.7–5.1 mm) but let the springs rest
 /// up to half a target deeper, softer under load: the 60-box column swayed 16.4 mm in 20 s
 /// instead of 8.5 (benches/RESULTS.md, "The preload held at rest").
