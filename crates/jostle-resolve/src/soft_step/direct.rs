@@ -253,6 +253,20 @@ impl DirectIslands {
             return;
         }
         let movable = |i: u32| i != STATIC_BODY && states[i as usize].inv_mass > 0.0;
+        let mixed = |a: u32, b: u32| {
+            let (ia, ib) = (states[a as usize].inv_mass, states[b as usize].inv_mass);
+            movable(a) && movable(b) && ia.max(ib) >= mass_ratio * ia.min(ib)
+        };
+        // Most scenes have no manifold between bodies of such different masses, and then no
+        // island: one pass over the lanes instead of the union-find (1.4% of a 20-row
+        // pyramid's step).
+        let any_mixed = batches
+            .manifolds
+            .iter()
+            .any(|m| (0..LANES).any(|l| mixed(m.a[l], m.b[l])));
+        if !any_mixed {
+            return;
+        }
         self.sets.reset(states.len());
         for m in &batches.manifolds {
             for l in 0..LANES {
@@ -277,9 +291,7 @@ impl DirectIslands {
                 };
                 let rows = points.iter().filter(|s| s[l] != NO_SOURCE).count() as u32;
                 self.row_count[root as usize] += rows;
-                let mass = |i: u32| states[i as usize].inv_mass;
-                let (ia, ib) = (mass(m.a[l]), mass(m.b[l]));
-                if movable(m.a[l]) && movable(m.b[l]) && ia.max(ib) >= mass_ratio * ia.min(ib) {
+                if mixed(m.a[l], m.b[l]) {
                     self.mixed[root as usize] = true;
                 }
             }
