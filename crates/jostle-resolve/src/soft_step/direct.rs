@@ -255,7 +255,7 @@ impl DirectIslands {
         let movable = |i: u32| i != STATIC_BODY && states[i as usize].inv_mass > 0.0;
         let mixed = |a: u32, b: u32| {
             let (ia, ib) = (states[a as usize].inv_mass, states[b as usize].inv_mass);
-            movable(a) && movable(b) && ia.max(ib) >= mass_ratio * ia.min(ib)
+            movable(a) && movable(b) && super::masses_apart(ia, ib, mass_ratio)
         };
         // Most scenes have no manifold between bodies of such different masses, and then no
         // island: one pass over the lanes instead of the union-find (1.4% of a 20-row

@@ -357,7 +357,7 @@ impl SoftStepResolver {
                 if a == STATIC_BODY || b == STATIC_BODY || ia <= 0.0 || ib <= 0.0 {
                     continue;
                 }
-                if ia.max(ib) >= ratio * ia.min(ib) {
+                if masses_apart(ia, ib, ratio) {
                     self.states[a as usize].flags |= body_state::EXACT_WARM;
                     self.states[b as usize].flags |= body_state::EXACT_WARM;
                     any = true;
@@ -628,6 +628,11 @@ pub const PARALLEL_MIN_BATCHES: usize = 128;
 /// anything the contacts resolve; carried at 1:10⁶ it pushed a 0.1 m box under its heavy load
 /// 6 mm into the floor within 13 steps (`tests/stress.rs` of the `jostle` crate).
 pub const EXACT_WARM_RATIO: f32 = 100.0;
+
+/// Whether two movable bodies' inverse masses (both > 0) differ by `ratio` or more.
+fn masses_apart(inv_mass_a: f32, inv_mass_b: f32, ratio: f32) -> bool {
+    inv_mass_a.max(inv_mass_b) >= ratio * inv_mass_a.min(inv_mass_b)
+}
 
 /// Batches per item of a team's stage ([`team`]).
 const TEAM_BATCH_CHUNK: u32 = 2;

@@ -485,8 +485,10 @@ wide_kernel! {
 /// a lower bound of the root that is exact for an isotropic K. Two leave the impulse within
 /// 10⁻⁴·r of the exact projection while K's eigenvalues differ by up to five times (a box's
 /// corner: about 2.2) and within 3·10⁻²·r at thirty times (unit test
-/// `disk_projection_matches_the_exact_one`). Each further iteration costs about 2.5% of a
-/// resting pyramid's resolve stage (benches/RESULTS.md, "A cheaper relax pass").
+/// `disk_projection_matches_the_exact_one`). Each further iteration cost about 2.5% of a
+/// resting pyramid's resolve stage in the form with three divisions per step
+/// (benches/RESULTS.md, "A cheaper relax pass"); the present form takes one and was not
+/// measured per iteration.
 const DISK_PROJECTION_ITERATIONS: usize = 2;
 
 /// Friction for one point of eight lanes: both tangents at once with the 2×2 effective mass
