@@ -375,6 +375,28 @@ pub fn variations() -> Vec<Case> {
     out
 }
 
+/// Perturbed heavy boxes on light ones from many seeds: pairs and 5-box columns at 1:100,
+/// 1:1,000 and 1:10,000, with unit boxes, 0.1 m boxes at μ 0.9 and 10 m boxes at μ 0.3, each
+/// from seeds 8 to 19, which no other set uses (216 cases).
+pub fn heavy_seeds() -> Vec<Case> {
+    let mut out = Vec::new();
+    for ratio in [100.0, 1000.0, 10000.0] {
+        for n in [2, 5] {
+            for (half, friction) in [(0.5, 0.5), (0.05, 0.9), (5.0, 0.3)] {
+                for seed in 8..=19 {
+                    let v = Variant {
+                        half,
+                        friction,
+                        seed: Some(seed),
+                    };
+                    out.push(heavy_on_light(ratio, n, v));
+                }
+            }
+        }
+    }
+    out
+}
+
 /// Heavy boxes on light ones beyond the family's own cases: pairs and 5-box columns at 1:10
 /// to 1:10,000, each with 0.1 m and 10 m boxes, μ 0.3 and 0.9, starts perturbed from seeds the
 /// family does not use (3 to 7), and mixes of these.

@@ -28,7 +28,9 @@
 //!    or want to and their friction rows, as sticking (in the biased pass too, where the
 //!    plain soft step solves no friction: friction the last relax pass left on a light body
 //!    is balanced by the normal load's distribution, and a biased solve that moves the load
-//!    without it spun a light box at 80 rad/s). An active set: normal rows whose total would
+//!    without it spun a light box at 80 rad/s; each friction row with at least a small
+//!    compliance of its own, [`FRICTION_REGULARISATION`], as a face's friction rows are more
+//!    than the motions they span). An active set: normal rows whose total would
 //!    pull are fixed at no impulse, friction that would leave its cone is fixed on it, and
 //!    the rest is solved again. J·M⁻¹·Jᵀ is built in f64 from the rows and the bodies'
 //!    inverse inertia (built in f32 it lost the heavy body of a 1:10⁶ pair in rounding and
@@ -62,6 +64,29 @@ use jostle_math::{Mat3, Vec3};
 /// their diagonal; a light body under a 10,000 times heavier one leaves about 1e-5.
 const DEPENDENT: f64 = 1e-9;
 
+/// Least compliance of a friction row in the direct solve, as a fraction of the smaller of
+/// its two bodies' parts of the row's diagonal of J·M⁻¹·Jᵀ (the heavier body's): each solve
+/// brings a sticking row to at least 1/(1 + this) of its target, and what is left goes to
+/// the next pass (sixteen passes a step).
+///
+/// Why: a face's four points give eight friction rows that span three motions, and the
+/// springs a heavy load stiffens gave them a compliance of about 2·10⁻⁶ of their diagonal, so
+/// whatever part of the targets no rigid motion meets was met with impulses half a million
+/// times that part, which the active set's clamps then turned into net pushes. Measured on a
+/// light column of five under a box 10,000 times heavier, started perturbed (the stability
+/// family's heavy set, seed 3): in the step where it fell, one biased pass's solve answered
+/// targets of 0.1–2.4 m/s with 5·10⁶–2·10⁷ N·s (the heavy box weighs 2·10⁵ N·s a substep);
+/// the light boxes left it at 1,000 m/s and moved 2 m within the substep.
+///
+/// Why the heavier body's part: a floor sized by the whole diagonal (the light body's part)
+/// leaves the heavy body's own friction converging at 1/(1 + this·M/m) per solve, and a 0.1 m
+/// box under one 10⁶ times heavier was pushed through the floor (`tests/stress.rs`). Cases
+/// meeting the stability criterion, the heavy set's 72 and 216 more from seeds no other set
+/// uses: no floor 68 and 185; this at 0.03 72 and 213 (one 1:10,000 column falls), 0.1 72
+/// and 213 (none falls; three 10 m columns at μ 0.3 drift 11–25 mm), 0.3 72 and 212 (three
+/// fall) (benches/RESULTS.md, "Friction rows regularised in the direct solve").
+const FRICTION_REGULARISATION: f32 = 0.1;
+
 /// Rounds of fixing rows that would pull or slide before the island is left to Gauss-Seidel
 /// alone.
 const ACTIVE_SET_ROUNDS: usize = 8;
@@ -91,6 +116,9 @@ struct Row {
     /// r_A × d and r_B × d.
     rn_a: Vec3,
     rn_b: Vec3,
+    /// A friction row's least compliance ([`FRICTION_REGULARISATION`]); set once the
+    /// inverse inertia is known.
+    floor: f64,
 }
 
 /// A point's normal row.
@@ -101,6 +129,33 @@ const TANGENT_1: u8 = 1;
 const TANGENT_2: u8 = 2;
 
 impl Row {
+    /// [`FRICTION_REGULARISATION`] times the smaller of the two bodies' parts of the row's
+    /// diagonal of J·M⁻¹·Jᵀ (a fixed body has none): the heavier body's, where the masses
+    /// differ, so that its motion still converges at that rate.
+    fn friction_floor(&self, inv_inertia: &impl Fn(u32) -> Mat3) -> f64 {
+        let part = |one: Row| one.coupling(&one, inv_inertia);
+        let sides = [
+            (self.a != STATIC_BODY).then(|| {
+                part(Row {
+                    b: STATIC_BODY,
+                    ..*self
+                })
+            }),
+            (self.b != STATIC_BODY).then(|| {
+                part(Row {
+                    a: STATIC_BODY,
+                    ..*self
+                })
+            }),
+        ];
+        let smaller = sides.into_iter().flatten().fold(f64::INFINITY, f64::min);
+        if smaller.is_finite() {
+            f64::from(FRICTION_REGULARISATION) * smaller
+        } else {
+            0.0
+        }
+    }
+
     /// The change of this row's normal velocity per unit impulse on `other`: (J·M⁻¹·Jᵀ)ᵢⱼ,
     /// in f64 from each shared body's inverse mass and world inverse inertia
     /// (`inv_inertia`), so that the island's matrix is a Gram matrix, symmetric and positive
@@ -340,6 +395,7 @@ impl DirectIslands {
                             normal: d,
                             rn_a: r_a.cross(d),
                             rn_b: r_b.cross(d),
+                            floor: 0.0,
                         });
                     }
                 }
@@ -371,6 +427,11 @@ impl DirectIslands {
                         *m = inv_inertia(k);
                     }
                 }
+            }
+        }
+        for row in &mut self.rows {
+            if row.kind != NORMAL {
+                row.floor = row.friction_floor(&inv_inertia);
             }
         }
         for &(start, end) in &self.islands {
@@ -517,13 +578,14 @@ impl Solver {
                     // Sticking: no sliding at the point, with the compliance of its normal
                     // row (the row before the first tangent's, two before the second's), so
                     // the friction of a face's points, which span fewer motions than they are
-                    // rows, is shared as the normal load is.
+                    // rows, is shared as the normal load is; at least the row's floor
+                    // (FRICTION_REGULARISATION).
                     let normal = i - kind as usize;
                     let impulse = p.tangent_impulse[kind as usize - 1][l];
                     let role = self.role[normal];
                     let state = RowState {
                         r: -row.velocity(states),
-                        compliance: self.residual[normal].compliance,
+                        compliance: self.residual[normal].compliance.max(row.floor as f32),
                     };
                     (state, impulse, role)
                 }
@@ -911,6 +973,7 @@ mod tests {
             normal,
             rn_a: arm_a.cross(normal),
             rn_b: arm_b.cross(normal),
+            floor: 0.0,
         };
         let corner = |x: f32, y: f32, z: f32| turn * Vec3::new(x, y, z) * 0.5;
         let rows = [
