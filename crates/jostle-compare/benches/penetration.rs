@@ -3,7 +3,8 @@
 //! engines (jostle's ground half-space is a fixed 4,000 m cuboid in rapier3d with its top face at
 //! y = 0; μ 0.6 on both sides; sleeping on in both, as the scenes declare), one run each of the
 //! scene's 300 steps; the table gives the deepest overlap of any contact over the run and the
-//! mean wall time per step (the penetration measuring included in neither).
+//! mean wall time per step (the penetration measuring included in neither), then per 30 steps
+//! each engine's mean time per step and how many bodies are awake.
 //!
 //! Run: `cargo bench -p jostle-compare --bench penetration` (about a minute). With `--test`
 //! (`cargo test -p jostle-compare --benches`) only 20 steps of the first scene run.
@@ -50,28 +51,63 @@ fn rapier_world(scene: &Scene) -> rp::PhysicsWorld {
     world
 }
 
-/// Deepest overlap (m) and mean time per step (ms) of `steps` steps of jostle at the scene's
-/// settings.
-fn jostle_run(scene: &Scene, steps: u32) -> (f32, f64) {
+/// Steps per row of the time series ([`Run::series`]).
+const WINDOW: usize = 30;
+
+/// What one engine's run of a scene measured.
+struct Run {
+    /// Deepest overlap of any contact over the run (m).
+    deepest: f32,
+    /// Mean wall time per step (ms).
+    ms_per_step: f64,
+    /// Per window of [`WINDOW`] steps: mean ms per step, and the bodies awake at its end.
+    series: Vec<(f64, usize)>,
+}
+
+/// Adds one step's time and awake count to `series` (a row per [`WINDOW`] steps).
+fn record(series: &mut Vec<(f64, usize)>, window: &mut Duration, step: usize, awake: usize) {
+    if (step + 1) % WINDOW == 0 {
+        series.push((window.as_secs_f64() * 1e3 / WINDOW as f64, awake));
+        *window = Duration::ZERO;
+    }
+}
+
+/// `steps` steps of jostle at the scene's settings.
+fn jostle_run(scene: &Scene, steps: u32) -> Run {
     let mut world = scene.build().expect("scene builds");
-    let (mut deepest, mut time) = (0.0f32, Duration::ZERO);
-    for _ in 0..steps {
+    let (mut deepest, mut time, mut window) = (0.0f32, Duration::ZERO, Duration::ZERO);
+    let mut series = Vec::new();
+    for step in 0..steps as usize {
         let t = Instant::now();
         world.step(scene.dt).expect("step");
-        time += t.elapsed();
+        let spent = t.elapsed();
+        time += spent;
+        window += spent;
         deepest = deepest.max(world.max_penetration());
+        let awake = world
+            .bodies()
+            .filter(|(_, _, b)| !b.is_fixed() && b.is_awake())
+            .count();
+        record(&mut series, &mut window, step, awake);
     }
-    (deepest, time.as_secs_f64() * 1e3 / f64::from(steps))
+    Run {
+        deepest,
+        ms_per_step: time.as_secs_f64() * 1e3 / f64::from(steps),
+        series,
+    }
 }
 
 /// The same for rapier3d.
-fn rapier_run(scene: &Scene, steps: u32) -> (f32, f64) {
+fn rapier_run(scene: &Scene, steps: u32) -> Run {
     let mut world = rapier_world(scene);
-    let (mut deepest, mut time) = (0.0f32, Duration::ZERO);
-    for _ in 0..steps {
+    let (mut deepest, mut time, mut window) = (0.0f32, Duration::ZERO, Duration::ZERO);
+    let mut series = Vec::new();
+    for step in 0..steps as usize {
         let t = Instant::now();
         world.step();
-        time += t.elapsed();
+        let spent = t.elapsed();
+        time += spent;
+        window += spent;
         for pair in world.narrow_phase.contact_pairs() {
             for m in pair.manifolds() {
                 for p in &m.points {
@@ -79,8 +115,18 @@ fn rapier_run(scene: &Scene, steps: u32) -> (f32, f64) {
                 }
             }
         }
+        let awake = world
+            .bodies
+            .iter()
+            .filter(|(_, b)| b.is_dynamic() && !b.is_sleeping())
+            .count();
+        record(&mut series, &mut window, step, awake);
     }
-    (deepest, time.as_secs_f64() * 1e3 / f64::from(steps))
+    Run {
+        deepest,
+        ms_per_step: time.as_secs_f64() * 1e3 / f64::from(steps),
+        series,
+    }
 }
 
 fn main() {
@@ -90,14 +136,37 @@ fn main() {
     } else {
         &["lattice_4000", "lattice_4000_offset"]
     };
+    let mut runs = Vec::new();
     println!("| scene | engine | deepest overlap (m) | ms/step |");
     println!("|---|---|---:|---:|");
     for name in scenes {
         let scene = common::scene(name);
         let steps = if smoke { 20 } else { scene.steps };
-        let (jd, jt) = jostle_run(&scene, steps);
-        println!("| {name} | jostle | {jd:.3} | {jt:.2} |");
-        let (rd, rt) = rapier_run(&scene, steps);
-        println!("| {name} | rapier3d 0.36 | {rd:.3} | {rt:.2} |");
+        let j = jostle_run(&scene, steps);
+        println!(
+            "| {name} | jostle | {:.3} | {:.2} |",
+            j.deepest, j.ms_per_step
+        );
+        let r = rapier_run(&scene, steps);
+        println!(
+            "| {name} | rapier3d 0.36 | {:.3} | {:.2} |",
+            r.deepest, r.ms_per_step
+        );
+        runs.push((name, j, r));
+    }
+    // Where the time goes over the run: the falling, the landing, the resting and the sleeping.
+    for (name, j, r) in &runs {
+        println!();
+        println!("{name}, per {WINDOW} steps: ms per step (bodies awake at the window's end)");
+        println!();
+        println!("| steps | jostle | rapier3d 0.36 |");
+        println!("|---|---:|---:|");
+        for (k, ((jt, ja), (rt, ra))) in j.series.iter().zip(&r.series).enumerate() {
+            println!(
+                "| {}–{} | {jt:.2} ({ja}) | {rt:.2} ({ra}) |",
+                k * WINDOW + 1,
+                (k + 1) * WINDOW
+            );
+        }
     }
 }
