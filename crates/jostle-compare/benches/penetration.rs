@@ -66,7 +66,7 @@ struct Run {
 
 /// Adds one step's time and awake count to `series` (a row per [`WINDOW`] steps).
 fn record(series: &mut Vec<(f64, usize)>, window: &mut Duration, step: usize, awake: usize) {
-    if (step + 1) % WINDOW == 0 {
+    if (step + 1).is_multiple_of(WINDOW) {
         series.push((window.as_secs_f64() * 1e3 / WINDOW as f64, awake));
         *window = Duration::ZERO;
     }
