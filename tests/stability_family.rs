@@ -186,7 +186,8 @@ fn load_compensation_removes_the_load_proportional_sink() {
 /// name contains one of its `|`-separated parts (`column 20|pyramid 40`); `FAMILY_SECONDS`
 /// sets the simulated time (default 20; the long runs use 60); `FAMILY_SET=heavy` runs the
 /// sweep of heavy boxes on light ones (`family::heavy_sweep`) instead of the family,
-/// `FAMILY_SET=heavy_seeds` the same from many more seeds (`family::heavy_seeds`).
+/// `FAMILY_SET=heavy_seeds` the same from many more seeds (`family::heavy_seeds`),
+/// `FAMILY_SET=tall` the tall members' variations (`family::tall_variations`).
 #[test]
 #[ignore = "a measurement of several minutes in release; run with --ignored --nocapture"]
 fn family_table() {
@@ -210,6 +211,7 @@ fn family_table() {
     let cases: Vec<Case> = match std::env::var("FAMILY_SET").as_deref() {
         Ok("heavy") => family::heavy_sweep(),
         Ok("heavy_seeds") => family::heavy_seeds(),
+        Ok("tall") => family::tall_variations(),
         _ => family::base()
             .into_iter()
             .chain(family::variations())

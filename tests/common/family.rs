@@ -375,6 +375,53 @@ pub fn variations() -> Vec<Case> {
     out
 }
 
+/// The tall members beyond the family's own variations: columns of 40 and 60, the 40-row
+/// pyramid, the 3D pyramid of 10 and the wall, each with 0.1 m and 10 m boxes, μ 0.3 and 0.9,
+/// starts perturbed from seeds 8 and 9, and two mixes (0.2 m boxes at μ 0.6 from seed 10,
+/// 2 m boxes at μ 0.4 from seed 11): 40 cases no other set has.
+pub fn tall_variations() -> Vec<Case> {
+    let d = Variant::default;
+    let variants = [
+        Variant { half: 0.05, ..d() },
+        Variant { half: 5.0, ..d() },
+        Variant {
+            friction: 0.3,
+            ..d()
+        },
+        Variant {
+            friction: 0.9,
+            ..d()
+        },
+        Variant {
+            seed: Some(8),
+            ..d()
+        },
+        Variant {
+            seed: Some(9),
+            ..d()
+        },
+        Variant {
+            half: 0.1,
+            friction: 0.6,
+            seed: Some(10),
+        },
+        Variant {
+            half: 1.0,
+            friction: 0.4,
+            seed: Some(11),
+        },
+    ];
+    let mut out = Vec::new();
+    for v in variants {
+        out.push(column(40, v));
+        out.push(column(60, v));
+        out.push(pyramid(40, v));
+        out.push(pyramid3d(10, v));
+        out.push(wall(20, 10, v));
+    }
+    out
+}
+
 /// Perturbed heavy boxes on light ones from many seeds: pairs and 5-box columns at 1:100,
 /// 1:1,000 and 1:10,000, with unit boxes, 0.1 m boxes at μ 0.9 and 10 m boxes at μ 0.3, each
 /// from seeds 8 to 19, which no other set uses (216 cases).

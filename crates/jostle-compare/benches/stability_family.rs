@@ -13,7 +13,8 @@
 //! Run: `cargo bench -p jostle-compare --bench stability_family` (several minutes; `FAMILY=base` runs only the
 //! base family, `FAMILY=variations` only the variations, `FAMILY=heavy` the sweep of heavy
 //! boxes on light ones (`family::heavy_sweep`), `FAMILY=heavy_seeds` the same from many more
-//! seeds (`family::heavy_seeds`); `FAMILY_ONLY` keeps the cases whose
+//! seeds (`family::heavy_seeds`), `FAMILY=tall` the tall members' variations
+//! (`family::tall_variations`); `FAMILY_ONLY` keeps the cases whose
 //! name contains one of its `|`-separated parts, as in `family_table`). With `--test` (`cargo
 //! test -p jostle-compare --benches`) only a short smoke run is made.
 
@@ -110,6 +111,8 @@ fn main() {
         cases.extend(family::heavy_sweep());
     } else if which == "heavy_seeds" {
         cases.extend(family::heavy_seeds());
+    } else if which == "tall" {
+        cases.extend(family::tall_variations());
     } else {
         if which != "variations" {
             cases.extend(family::base());
