@@ -335,32 +335,7 @@ pub fn base() -> Vec<Case> {
 /// seeds, the 60-row pyramid too).
 pub fn variations() -> Vec<Case> {
     let mut out = Vec::new();
-    let variants = [
-        Variant {
-            half: 0.05,
-            ..Variant::default()
-        },
-        Variant {
-            half: 5.0,
-            ..Variant::default()
-        },
-        Variant {
-            friction: 0.3,
-            ..Variant::default()
-        },
-        Variant {
-            friction: 0.9,
-            ..Variant::default()
-        },
-        Variant {
-            seed: Some(1),
-            ..Variant::default()
-        },
-        Variant {
-            seed: Some(2),
-            ..Variant::default()
-        },
-    ];
+    let variants = with_sizes_and_frictions(&[seeded(1), seeded(2)]);
     for v in variants {
         out.push(column(20, v));
         out.push(pyramid(20, v));
@@ -375,13 +350,19 @@ pub fn variations() -> Vec<Case> {
     out
 }
 
-/// The tall members beyond the family's own variations: columns of 40 and 60, the 40-row
-/// pyramid, the 3D pyramid of 10 and the wall, each with 0.1 m and 10 m boxes, μ 0.3 and 0.9,
-/// starts perturbed from seeds 8 and 9, and two mixes (0.2 m boxes at μ 0.6 from seed 10,
-/// 2 m boxes at μ 0.4 from seed 11): 40 cases no other set has.
-pub fn tall_variations() -> Vec<Case> {
+/// The default variant started perturbed from `seed`.
+fn seeded(seed: u64) -> Variant {
+    Variant {
+        seed: Some(seed),
+        ..Variant::default()
+    }
+}
+
+/// The four variations of size and friction every sweep takes (0.1 m and 10 m boxes, μ 0.3
+/// and 0.9), then `more`.
+fn with_sizes_and_frictions(more: &[Variant]) -> Vec<Variant> {
     let d = Variant::default;
-    let variants = [
+    let mut out = vec![
         Variant { half: 0.05, ..d() },
         Variant { half: 5.0, ..d() },
         Variant {
@@ -392,14 +373,19 @@ pub fn tall_variations() -> Vec<Case> {
             friction: 0.9,
             ..d()
         },
-        Variant {
-            seed: Some(8),
-            ..d()
-        },
-        Variant {
-            seed: Some(9),
-            ..d()
-        },
+    ];
+    out.extend_from_slice(more);
+    out
+}
+
+/// The tall members beyond the family's own variations: columns of 40 and 60, the 40-row
+/// pyramid, the 3D pyramid of 10 and the wall, each with 0.1 m and 10 m boxes, μ 0.3 and 0.9,
+/// starts perturbed from seeds 8 and 9, and two mixes (0.2 m boxes at μ 0.6 from seed 10,
+/// 2 m boxes at μ 0.4 from seed 11): 40 cases no other set has.
+pub fn tall_variations() -> Vec<Case> {
+    let variants = with_sizes_and_frictions(&[
+        seeded(8),
+        seeded(9),
         Variant {
             half: 0.1,
             friction: 0.6,
@@ -410,7 +396,7 @@ pub fn tall_variations() -> Vec<Case> {
             friction: 0.4,
             seed: Some(11),
         },
-    ];
+    ]);
     let mut out = Vec::new();
     for v in variants {
         out.push(column(40, v));
@@ -449,29 +435,10 @@ pub fn heavy_seeds() -> Vec<Case> {
 /// family does not use (3 to 7), and mixes of these.
 pub fn heavy_sweep() -> Vec<Case> {
     let d = Variant::default;
-    let variants = [
-        Variant { half: 0.05, ..d() },
-        Variant { half: 5.0, ..d() },
-        Variant {
-            friction: 0.3,
-            ..d()
-        },
-        Variant {
-            friction: 0.9,
-            ..d()
-        },
-        Variant {
-            seed: Some(3),
-            ..d()
-        },
-        Variant {
-            seed: Some(4),
-            ..d()
-        },
-        Variant {
-            seed: Some(5),
-            ..d()
-        },
+    let variants = with_sizes_and_frictions(&[
+        seeded(3),
+        seeded(4),
+        seeded(5),
         Variant {
             half: 0.05,
             seed: Some(6),
@@ -482,11 +449,11 @@ pub fn heavy_sweep() -> Vec<Case> {
             friction: 0.3,
             seed: Some(7),
         },
-    ];
+    ]);
     let mut out = Vec::new();
     for ratio in [10.0, 100.0, 1000.0, 10000.0] {
         for n in [2, 5] {
-            for v in variants {
+            for &v in &variants {
                 out.push(heavy_on_light(ratio, n, v));
             }
         }

@@ -72,23 +72,25 @@ fn record(series: &mut Vec<(f64, usize)>, window: &mut Duration, step: usize, aw
     }
 }
 
-/// `steps` steps of jostle at the scene's settings.
-fn jostle_run(scene: &Scene, steps: u32) -> Run {
-    let mut world = scene.build().expect("scene builds");
+/// `steps` steps of `world` by `step`, each timed; after each, `look` gives the deepest
+/// overlap of any contact now and the bodies awake (neither timed).
+fn timed<W>(
+    world: &mut W,
+    steps: u32,
+    step: impl Fn(&mut W),
+    look: impl Fn(&W) -> (f32, usize),
+) -> Run {
     let (mut deepest, mut time, mut window) = (0.0f32, Duration::ZERO, Duration::ZERO);
     let mut series = Vec::new();
-    for step in 0..steps as usize {
+    for k in 0..steps as usize {
         let t = Instant::now();
-        world.step(scene.dt).expect("step");
+        step(world);
         let spent = t.elapsed();
         time += spent;
         window += spent;
-        deepest = deepest.max(world.max_penetration());
-        let awake = world
-            .bodies()
-            .filter(|(_, _, b)| !b.is_fixed() && b.is_awake())
-            .count();
-        record(&mut series, &mut window, step, awake);
+        let (depth, awake) = look(world);
+        deepest = deepest.max(depth);
+        record(&mut series, &mut window, k, awake);
     }
     Run {
         deepest,
@@ -97,36 +99,47 @@ fn jostle_run(scene: &Scene, steps: u32) -> Run {
     }
 }
 
+/// `steps` steps of jostle at the scene's settings.
+fn jostle_run(scene: &Scene, steps: u32) -> Run {
+    let mut world = scene.build().expect("scene builds");
+    timed(
+        &mut world,
+        steps,
+        |w| {
+            w.step(scene.dt).expect("step");
+        },
+        |w| {
+            let awake = w
+                .bodies()
+                .filter(|(_, _, b)| !b.is_fixed() && b.is_awake())
+                .count();
+            (w.max_penetration(), awake)
+        },
+    )
+}
+
 /// The same for rapier3d.
 fn rapier_run(scene: &Scene, steps: u32) -> Run {
     let mut world = rapier_world(scene);
-    let (mut deepest, mut time, mut window) = (0.0f32, Duration::ZERO, Duration::ZERO);
-    let mut series = Vec::new();
-    for step in 0..steps as usize {
-        let t = Instant::now();
-        world.step();
-        let spent = t.elapsed();
-        time += spent;
-        window += spent;
-        for pair in world.narrow_phase.contact_pairs() {
-            for m in pair.manifolds() {
-                for p in &m.points {
-                    deepest = deepest.max(-p.dist);
-                }
-            }
-        }
-        let awake = world
-            .bodies
-            .iter()
-            .filter(|(_, b)| b.is_dynamic() && !b.is_sleeping())
-            .count();
-        record(&mut series, &mut window, step, awake);
-    }
-    Run {
-        deepest,
-        ms_per_step: time.as_secs_f64() * 1e3 / f64::from(steps),
-        series,
-    }
+    timed(
+        &mut world,
+        steps,
+        |w| w.step(),
+        |w| {
+            let deepest = w
+                .narrow_phase
+                .contact_pairs()
+                .flat_map(|pair| pair.manifolds())
+                .flat_map(|m| m.points.iter())
+                .fold(0.0f32, |d, p| d.max(-p.dist));
+            let awake = w
+                .bodies
+                .iter()
+                .filter(|(_, b)| b.is_dynamic() && !b.is_sleeping())
+                .count();
+            (deepest, awake)
+        },
+    )
 }
 
 fn main() {
