@@ -82,9 +82,10 @@ const DEPENDENT: f64 = 1e-9;
 /// leaves the heavy body's own friction converging at 1/(1 + this·M/m) per solve, and a 0.1 m
 /// box under one 10⁶ times heavier was pushed through the floor (`tests/stress.rs`). Cases
 /// meeting the stability criterion, the heavy set's 72 and 216 more from seeds no other set
-/// uses, with contact frames held to 2 mm (`frame_tolerance` then): no floor 68 and 185; this at 0.03 72 and 213 (one 1:10,000 column falls), 0.1 72
-/// and 213 (none falls; three 10 m columns at μ 0.3 drift 11–25 mm), 0.3 72 and 212 (three
-/// fall) (benches/RESULTS.md, "Friction rows regularised in the direct solve").
+/// uses, measured with contact frames held to 2 mm (`frame_tolerance` then): no floor 68 and
+/// 185; this at 0.03 72 and 213 (one 1:10,000 column falls), 0.1 72 and 213 (none falls;
+/// three 10 m columns at μ 0.3 drift 11–25 mm), 0.3 72 and 212 (three fall)
+/// (benches/RESULTS.md, "Friction rows regularised in the direct solve").
 const FRICTION_REGULARISATION: f32 = 0.1;
 
 /// Rounds of fixing rows that would pull or slide before the island is left to Gauss-Seidel
