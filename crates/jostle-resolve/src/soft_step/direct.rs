@@ -22,8 +22,10 @@
 //!    mass its load stands for, Λ/(|g|·h) for the per-substep impulse Λ its points start the
 //!    step with, where that exceeds their effective mass (the same ω and ζ, so a loaded
 //!    manifold settles at about g/ω² whatever its load);
-//! 2. after each biased and each relax pass, [`DirectIslands::correct`] solves the island's
-//!    rows exactly as the pass states them ([`super::solve::row_residuals`]):
+//! 2. after the first substep's warm start (the last step's impulses on this step's
+//!    contacts, whose error a light body between heavy ones feels as a velocity M/m times
+//!    larger), and after each biased and each relax pass, [`DirectIslands::correct`] solves
+//!    the island's rows exactly as the pass states them ([`super::solve::row_residuals`]):
 //!    (J·M⁻¹·Jᵀ + C)·x = r, with C the springs' compliance, over the normal rows that push
 //!    or want to and their friction rows, as sticking (in the biased pass too, where the
 //!    plain soft step solves no friction: friction the last relax pass left on a light body
