@@ -98,6 +98,12 @@ pub struct BroadPhase {
     changed: Vec<u32>,
     /// Scratch: `changed` as a mask over slots.
     changed_mask: Vec<bool>,
+    /// Scratch: the fat pairs found again around changed leaves, before they are merged.
+    fresh_fat_pairs: Vec<(u32, u32)>,
+    /// Scratch: the kept and the fresh fat pairs merged, then swapped with `fat_pairs`.
+    merged_fat_pairs: Vec<(u32, u32)>,
+    /// Scratch: the reported pairs while two sorted runs of them are merged.
+    merged_pairs: Vec<ColliderPair>,
 }
 
 impl std::fmt::Debug for BroadPhase {
@@ -153,6 +159,9 @@ impl BroadPhase {
             fat_pairs_valid: false,
             changed: Vec::new(),
             changed_mask: Vec::new(),
+            fresh_fat_pairs: Vec::new(),
+            merged_fat_pairs: Vec::new(),
+            merged_pairs: Vec::new(),
         }
     }
 
@@ -503,7 +512,11 @@ impl BroadPhase {
             }
             let mask = &self.changed_mask;
             let touched = |i: u32| mask.get(i as usize).copied().unwrap_or(true);
+            // What is kept stays sorted and unique; the pairs found again are sorted on their
+            // own and merged in (a full sort of every pair took a third of a falling rain's
+            // broad phase).
             self.fat_pairs.retain(|&(i, j)| !touched(i) && !touched(j));
+            self.fresh_fat_pairs.clear();
             for &c in &self.changed {
                 // A slot may be listed several times: query its leaf once (clearing its bit).
                 let first = self
@@ -516,11 +529,21 @@ impl BroadPhase {
                 if let Some(fat) = leaf(&self.proxies, c) {
                     for j in self.tree.intersect_aabb(&fat) {
                         if j != c {
-                            self.fat_pairs.push((c.min(j), c.max(j)));
+                            self.fresh_fat_pairs.push((c.min(j), c.max(j)));
                         }
                     }
                 }
             }
+            self.fresh_fat_pairs.sort_unstable();
+            self.fresh_fat_pairs.dedup();
+            merge_sorted(
+                &self.fat_pairs,
+                &self.fresh_fat_pairs,
+                &mut self.merged_fat_pairs,
+            );
+            std::mem::swap(&mut self.fat_pairs, &mut self.merged_fat_pairs);
+            self.changed.clear();
+            return;
         } else {
             return;
         }
@@ -541,6 +564,9 @@ impl BroadPhase {
                 self.changed.clear();
             }
             self.find_pairs_from_awake();
+            self.find_unbounded_pairs();
+            self.pairs.sort_unstable();
+            self.pairs.dedup();
         } else {
             self.repair_fat_pairs();
             // Every reported bounded pair has overlapping fat boxes (each enlarged box lies in
@@ -562,10 +588,20 @@ impl BroadPhase {
                     ColliderHandle::new(j, pj.generation),
                 ));
             }
+            // The fat pairs are sorted by slot and unique, so these are sorted and unique
+            // (handles order by slot first); the half-space pairs, never in the tree, are
+            // sorted on their own and merged in.
+            let bounded = self.pairs.len();
+            self.find_unbounded_pairs();
+            self.pairs[bounded..].sort_unstable();
+            debug_assert!(self.pairs[..bounded].is_sorted());
+            merge_sorted(
+                &self.pairs[..bounded],
+                &self.pairs[bounded..],
+                &mut self.merged_pairs,
+            );
+            std::mem::swap(&mut self.pairs, &mut self.merged_pairs);
         }
-        self.find_unbounded_pairs();
-        self.pairs.sort_unstable();
-        self.pairs.dedup();
     }
 
     /// The bounded pairs found by querying the tree with each awake collider's enlarged box.
@@ -639,6 +675,33 @@ impl BroadPhase {
             }
         }
     }
+}
+
+/// `a` and `b`, each sorted, merged into `out` (cleared first), sorted, without the
+/// duplicates of equal items (each list's own must be unique already).
+fn merge_sorted<T: Ord + Copy>(a: &[T], b: &[T], out: &mut Vec<T>) {
+    out.clear();
+    out.reserve(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        match a[i].cmp(&b[j]) {
+            std::cmp::Ordering::Less => {
+                out.push(a[i]);
+                i += 1;
+            }
+            std::cmp::Ordering::Greater => {
+                out.push(b[j]);
+                j += 1;
+            }
+            std::cmp::Ordering::Equal => {
+                out.push(a[i]);
+                i += 1;
+                j += 1;
+            }
+        }
+    }
+    out.extend_from_slice(&a[i..]);
+    out.extend_from_slice(&b[j..]);
 }
 
 /// Identity of a collider's shape (the address of its shared allocation), so that replacing
