@@ -11,45 +11,11 @@
 
 #[path = "../../../benches/common/mod.rs"]
 mod common;
+#[path = "rapier_scene.rs"]
+mod rapier_scene;
 
 use jostle::scene::Scene;
-use rapier3d::prelude as rp;
 use std::time::{Duration, Instant};
-
-/// The scene's boxes in rapier3d at its defaults (dt 1/60).
-fn rapier_world(scene: &Scene) -> rp::PhysicsWorld {
-    let mut world = rp::PhysicsWorld {
-        gravity: rp::Vector::new(0.0, -9.81, 0.0),
-        ..Default::default()
-    };
-    world.integration_parameters.dt = scene.dt;
-    for desc in scene.body_descs().expect("scene bodies") {
-        let friction = desc.material.friction;
-        if desc.fixed {
-            world.insert(
-                rp::RigidBodyBuilder::fixed().translation(rp::Vector::new(0.0, -1.0, 0.0)),
-                rp::ColliderBuilder::cuboid(2000.0, 1.0, 2000.0).friction(friction),
-            );
-            continue;
-        }
-        let jostle::ShapeDesc::Cuboid { half_extents: h } = desc.shape else {
-            panic!("{}: only cuboids", scene.name);
-        };
-        let jostle::MassSpec::Density(density) = desc.mass else {
-            panic!("{}: densities only", scene.name);
-        };
-        let (p, q) = (desc.position, desc.rotation);
-        world.insert(
-            rp::RigidBodyBuilder::dynamic()
-                .translation(rp::Vector::new(p.x, p.y, p.z))
-                .rotation(rp::Rotation::from_xyzw(q.x, q.y, q.z, q.w).to_scaled_axis()),
-            rp::ColliderBuilder::cuboid(h.x, h.y, h.z)
-                .density(density)
-                .friction(friction),
-        );
-    }
-    world
-}
 
 /// Steps per row of the time series ([`Run::series`]).
 const WINDOW: usize = 30;
@@ -120,24 +86,16 @@ fn jostle_run(scene: &Scene, steps: u32) -> Run {
 
 /// The same for rapier3d.
 fn rapier_run(scene: &Scene, steps: u32) -> Run {
-    let mut world = rapier_world(scene);
+    let mut world = rapier_scene::rapier_world(scene);
     timed(
         &mut world,
         steps,
         |w| w.step(),
         |w| {
-            let deepest = w
-                .narrow_phase
-                .contact_pairs()
-                .flat_map(|pair| pair.manifolds())
-                .flat_map(|m| m.points.iter())
-                .fold(0.0f32, |d, p| d.max(-p.dist));
-            let awake = w
-                .bodies
-                .iter()
-                .filter(|(_, b)| b.is_dynamic() && !b.is_sleeping())
-                .count();
-            (deepest, awake)
+            (
+                rapier_scene::rapier_deepest(w),
+                rapier_scene::rapier_awake(w),
+            )
         },
     )
 }
