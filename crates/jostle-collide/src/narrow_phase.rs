@@ -1110,7 +1110,10 @@ fn reusable(
         c.prediction == prediction
             && c.shapes == shapes
             && c.pos12.translation.distance(pos12.translation) < settings.reuse_linear
-            && c.pos12.rotation.angle_between(pos12.rotation) < settings.reuse_angular
+            // The sine of half the turn, from the relative rotation's vector part: through the
+            // cosine (`angle_between`) f32 reads any turn below about 5·10⁻⁴ rad as none.
+            && (c.pos12.rotation.conjugate() * pos12.rotation).xyz().length()
+                < (0.5 * settings.reuse_angular).sin()
     })
 }
 

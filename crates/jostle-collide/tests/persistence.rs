@@ -111,6 +111,22 @@ fn nothing_moved_means_reused_manifolds() {
 }
 
 #[test]
+fn a_turn_beyond_the_angular_tolerance_recomputes_the_manifold() {
+    // The default tolerance is 10⁻⁴ rad. Measured through the cosine of half the turn, as it
+    // once was, a turn of 3·10⁻⁴ rad read as none in f32 (cos 1.5·10⁻⁴ rounds to 1), and
+    // the manifold was kept.
+    for (angle, reused) in [(3e-4, 0), (3e-5, 1)] {
+        let mut scene = Scene::new();
+        scene.fixed(&ground(), Vec3::ZERO);
+        let cube = scene.dynamic(&unit_cube(), Vec3::new(0.0, 0.49, 0.0));
+        scene.step();
+        scene.turn_by(cube, Quat::from_rotation_z(angle));
+        let stats = scene.step();
+        assert_eq!(stats.manifolds_reused, reused, "a turn of {angle} rad");
+    }
+}
+
+#[test]
 fn reused_manifolds_follow_the_bodies() {
     // Two dynamic balls moved together by 10 m: their relative pose is unchanged, so the
     // manifold is reused, but the world point must move with them.

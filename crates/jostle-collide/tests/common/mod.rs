@@ -71,6 +71,11 @@ impl Scene {
     pub fn move_by(&mut self, body: BodyHandle, delta: Vec3) {
         self.bodies.get_mut(body).unwrap().position += delta;
     }
+
+    pub fn turn_by(&mut self, body: BodyHandle, turn: jostle_math::Quat) {
+        let body = self.bodies.get_mut(body).unwrap();
+        body.orientation = (turn * body.orientation).normalize();
+    }
 }
 
 pub fn ground() -> ShapeDesc {
