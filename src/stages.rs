@@ -99,7 +99,12 @@ pub(crate) fn wake_touching(
     settings: &SleepSettings,
 ) -> bool {
     let mut woke = false;
+    // A pair's points are listed together: the first decides for the rest.
+    let mut last = None;
     for c in contacts {
+        if last.replace((c.a, c.b)) == Some((c.a, c.b)) {
+            continue;
+        }
         let (Some(a), Some(b)) = (bodies.get(c.a), bodies.get(c.b)) else {
             continue;
         };
@@ -235,8 +240,19 @@ pub(crate) fn gather(
             (i != NO_SOLVER).then_some(i)
         }
     };
+    // A pair's points are listed together: their bodies are looked up once.
+    type Pair = (jostle_body::BodyHandle, jostle_body::BodyHandle);
+    let mut last: Option<(Pair, Option<(u32, u32)>)> = None;
     for (i, c) in contacts.iter().enumerate() {
-        let (Some(a), Some(b)) = (index_of(c.a), index_of(c.b)) else {
+        let indices = match last {
+            Some((pair, indices)) if pair == (c.a, c.b) => indices,
+            _ => {
+                let indices = index_of(c.a).zip(index_of(c.b));
+                last = Some(((c.a, c.b), indices));
+                indices
+            }
+        };
+        let Some((a, b)) = indices else {
             continue;
         };
         if a == STATIC_BODY && b == STATIC_BODY {
