@@ -86,7 +86,7 @@ fn jostle_run(scene: &Scene, steps: u32) -> Run {
 
 /// The same for rapier3d.
 fn rapier_run(scene: &Scene, steps: u32) -> Run {
-    let mut world = rapier_scene::rapier_world(scene);
+    let (mut world, _) = rapier_scene::rapier_world(scene);
     timed(
         &mut world,
         steps,

@@ -16,14 +16,16 @@ use jostle::{MassSpec, ShapeDesc};
 use rapier3d::prelude as rp;
 
 /// The scene's bodies in a rapier3d world at its defaults, with the scene's time step and
-/// sleeping as the scene declares it.
-pub fn rapier_world(scene: &Scene) -> rp::PhysicsWorld {
+/// sleeping as the scene declares it; and the handles of its dynamic bodies, in the scene's
+/// order.
+pub fn rapier_world(scene: &Scene) -> (rp::PhysicsWorld, Vec<rp::RigidBodyHandle>) {
     let mut world = rp::PhysicsWorld {
         gravity: rp::Vector::new(0.0, -9.81, 0.0),
         ..Default::default()
     };
     world.integration_parameters.dt = scene.dt;
     let sleeping = scene.settings().sleep.enabled;
+    let mut dynamic = Vec::new();
     for desc in scene.body_descs().expect("scene bodies") {
         let friction = desc.material.friction;
         let (p, q) = (desc.position, desc.rotation);
@@ -72,13 +74,16 @@ pub fn rapier_world(scene: &Scene) -> rp::PhysicsWorld {
             };
             shape.density(density).friction(friction)
         };
-        world.insert(
+        let (handle, _) = world.insert(
             body.translation(rp::Vector::new(p.x, p.y, p.z))
                 .rotation(rp::Rotation::from_xyzw(q.x, q.y, q.z, q.w).to_scaled_axis()),
             collider,
         );
+        if !desc.fixed {
+            dynamic.push(handle);
+        }
     }
-    world
+    (world, dynamic)
 }
 
 /// Contact pairs with at least one point, and contact points, in rapier3d's narrow phase now.

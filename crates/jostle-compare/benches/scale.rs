@@ -249,7 +249,7 @@ fn jostle_run(case: &Case, steps: u32) -> (World, Run) {
 }
 
 fn rapier_run(case: &Case, steps: u32) -> (rp::PhysicsWorld, Run) {
-    let mut world = rapier_scene::rapier_world(&case.scene);
+    let (mut world, _) = rapier_scene::rapier_world(&case.scene);
     let mut sums = [Duration::ZERO; 6];
     let (mut total, mut deepest) = (Duration::ZERO, 0.0f32);
     for _ in 0..steps {

@@ -20,56 +20,12 @@
 
 #[path = "../../../tests/common/family.rs"]
 mod family;
+#[path = "rapier_scene.rs"]
+mod rapier_scene;
 
-use family::{Case, Subject};
+use family::Subject;
 use jostle::{ResolverChoice, SoftStepSettings, Vec3};
 use rapier3d::prelude as rp;
-
-/// The case in rapier3d at its defaults, sleeping disabled.
-fn rapier_world(case: &Case) -> (rp::PhysicsWorld, Vec<rp::RigidBodyHandle>) {
-    let scene = family::parse(case);
-    let mut world = rp::PhysicsWorld {
-        gravity: rp::Vector::new(0.0, -9.81, 0.0),
-        ..Default::default()
-    };
-    world.integration_parameters.dt = 1.0 / 60.0;
-    let mut handles = Vec::new();
-    for desc in scene.body_descs().expect("scene bodies") {
-        let friction = desc.material.friction;
-        if desc.fixed {
-            assert_eq!(
-                desc.shape,
-                jostle::ShapeDesc::HalfSpace { normal: Vec3::Y },
-                "{}: the only fixed body is the ground",
-                case.name
-            );
-            world.insert(
-                rp::RigidBodyBuilder::fixed().translation(rp::Vector::new(0.0, -1.0, 0.0)),
-                rp::ColliderBuilder::cuboid(2000.0, 1.0, 2000.0).friction(friction),
-            );
-            continue;
-        }
-        let jostle::ShapeDesc::Cuboid { half_extents: h } = desc.shape else {
-            panic!("{}: only cuboids", case.name);
-        };
-        let jostle::MassSpec::Density(density) = desc.mass else {
-            panic!("{}: densities only", case.name);
-        };
-        let p = desc.position;
-        let q = desc.rotation;
-        let (handle, _) = world.insert(
-            rp::RigidBodyBuilder::dynamic()
-                .translation(rp::Vector::new(p.x, p.y, p.z))
-                .rotation(rp::Rotation::from_xyzw(q.x, q.y, q.z, q.w).to_scaled_axis())
-                .can_sleep(false),
-            rp::ColliderBuilder::cuboid(h.x, h.y, h.z)
-                .density(density)
-                .friction(friction),
-        );
-        handles.push(handle);
-    }
-    (world, handles)
-}
 
 /// A case in rapier3d, for [`family::measure`].
 struct Rapier {
@@ -137,7 +93,7 @@ fn main() {
             seconds,
             Some(ResolverChoice::SoftStep(SoftStepSettings::default())),
         );
-        let (world, boxes) = rapier_world(case);
+        let (world, boxes) = rapier_scene::rapier_world(&family::parse(case));
         let r = family::measure(
             &mut Rapier { world, boxes },
             &family::nominal(case),
