@@ -19,7 +19,7 @@ use crate::reduce::reduce_manifold;
 use crate::settings::CollideSettings;
 use crate::shape::MAX_EXTENT;
 use jostle_body::{BodyHandle, BodySet, CcdMode};
-use jostle_math::Vec3;
+use jostle_math::{Quat, Vec3};
 use parry3d::math::Pose;
 use parry3d::query::{
     ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
@@ -1021,21 +1021,23 @@ fn frames_still_held(
     let Some((checked1, checked2, checked_flip)) = &state.checked else {
         return false;
     };
-    // The sine of half the turn, from the relative rotation's vector part: resolvable in f32
-    // down to about 10⁻⁷ rad, where the cosine is not.
-    let half_sin = (0.5 * settings.reuse_angular).sin();
-    let unturned = |before: &Pose, now: &Pose| {
-        (before.rotation.conjugate() * now.rotation).xyz().length() < half_sin
-    };
     *checked_flip == flip
         && settings.frame_tolerance > 0.0
-        && unturned(checked1, pose1)
-        && unturned(checked2, pose2)
+        && turned_less(checked1.rotation, pose1.rotation, settings.reuse_angular)
+        && turned_less(checked2.rotation, pose2.rotation, settings.reuse_angular)
         && state.manifolds.iter().all(|m| {
             m.points
                 .iter()
                 .all(|p| p.data.frame.is_some() && p.dist <= settings.prediction)
         })
+}
+
+/// Whether the unit rotation `now` is less than `angle` (rad) from `before`: compared through
+/// the sine of half the turn, the vector part of the relative rotation, which f32 resolves down
+/// to about 10⁻⁷ rad; through the cosine (`Quat::angle_between`) it reads any turn below about
+/// 5·10⁻⁴ rad as none.
+fn turned_less(before: Quat, now: Quat, angle: f32) -> bool {
+    (before.conjugate() * now).xyz().length() < (0.5 * angle).sin()
 }
 
 /// Appends the contact of point `pt` with frame `frame` between bodies A and B.
@@ -1110,10 +1112,7 @@ fn reusable(
         c.prediction == prediction
             && c.shapes == shapes
             && c.pos12.translation.distance(pos12.translation) < settings.reuse_linear
-            // The sine of half the turn, from the relative rotation's vector part: through the
-            // cosine (`angle_between`) f32 reads any turn below about 5·10⁻⁴ rad as none.
-            && (c.pos12.rotation.conjugate() * pos12.rotation).xyz().length()
-                < (0.5 * settings.reuse_angular).sin()
+            && turned_less(c.pos12.rotation, pos12.rotation, settings.reuse_angular)
     })
 }
 
