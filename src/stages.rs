@@ -303,6 +303,12 @@ pub(crate) fn ccd(
         return;
     }
     scratch.ccd_stops.clear();
+    if scratch.bodies.len() <= 1 {
+        // Only the static entry: no body moved this step (all asleep, fixed or resting
+        // kinematic), so none is swept; the colliders are not walked.
+        p.ccd_hits = 0;
+        return;
+    }
     // First which colliders are fast (swept); those of other awake bodies are slow targets,
     // taken at their start poses (a bullet into a stack of awake boxes).
     scratch.ccd_fast.clear();
