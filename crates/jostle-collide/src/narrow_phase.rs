@@ -940,12 +940,12 @@ fn update_pair(
                     continue;
                 };
                 touches |= pt.dist <= 0.0;
-                push_contact(out, (a, b), (body_a, body_b), frame, pt, &material);
-                out.slots.push(PointSlot {
+                let slot = PointSlot {
                     pair: pair_index,
                     manifold: mi as u32,
                     point: pi as u32,
-                });
+                };
+                push_contact(out, slot, (a, b), (body_a, body_b), frame, pt, &material);
             }
             continue;
         }
@@ -991,12 +991,12 @@ fn update_pair(
                 settings.frame_tolerance,
                 out.min_cos,
             );
-            push_contact(out, (a, b), (body_a, body_b), frame, pt, &material);
-            out.slots.push(PointSlot {
+            let slot = PointSlot {
                 pair: pair_index,
                 manifold: mi as u32,
                 point: pi as u32,
-            });
+            };
+            push_contact(out, slot, (a, b), (body_a, body_b), frame, pt, &material);
         }
     }
     if touches {
@@ -1040,9 +1040,11 @@ fn turned_less(before: Quat, now: Quat, angle: f32) -> bool {
     (before.conjugate() * now).xyz().length() < (0.5 * angle).sin()
 }
 
-/// Appends the contact of point `pt` with frame `frame` between bodies A and B.
+/// Appends the contact of point `pt` with frame `frame` between bodies A and B, and where
+/// it lives (`slot`).
 fn push_contact(
     out: &mut PairOutputs<'_>,
+    slot: PointSlot,
     (a, b): (BodyHandle, BodyHandle),
     (body_a, body_b): (&jostle_body::RigidBody, &jostle_body::RigidBody),
     frame: Frame,
@@ -1062,6 +1064,7 @@ fn push_contact(
         impulse: pt.data.impulse,
         preload: pt.data.preload,
     });
+    out.slots.push(slot);
 }
 
 /// Walks two sorted, deduplicated lists together: `f(item, false)` for each item only in

@@ -17,7 +17,9 @@ pub struct CollideSettings {
     /// the manifold is reused: only the separations are refreshed from the stored local points.
     /// 0 disables reuse.
     pub reuse_linear: f32,
-    /// Angular reuse tolerance (rad). Default 1e-4. See `reuse_linear`.
+    /// Angular reuse tolerance (rad). Default 1e-4. See `reuse_linear`. Also how far a reused
+    /// pair's colliders may turn before its held contact frames (`frame_tolerance`) are
+    /// checked against fresh ones again.
     pub reuse_angular: f32,
     /// Contact-frame tolerance (m). Default 0.004.
     ///

@@ -4,8 +4,8 @@
 //! defaults, in the same run.
 //!
 //! - `piles_N`: 5-box piles of unit boxes on a 3 m grid (`Piles`), sleeping off;
-//! - `rain_N`: boxes, balls, capsules and cylinders (a quarter each, 0.3–0.5 m) in ten layers
-//!   0.8 m apart, jittered and tilted from a fixed seed, raining into a walled square,
+//! - `rain_N`: boxes, balls, capsules and cylinders (a quarter each, 0.3–0.7 m long) in ten
+//!   layers 0.8 m apart, jittered and tilted from a fixed seed, raining into a walled square,
 //!   sleeping off;
 //! - `pyramid_40` (820 boxes), `pyramid3d_20` (2,870), `pyramid3d_30` (9,455), sleeping off;
 //! - `lattice_4000` (`assets/lattice_4000.ron`), sleeping on as the scene declares it.
@@ -17,7 +17,7 @@
 //! of each engine's world as that run left it (`scale/<scene>/jostle`, `.../rapier3d`). The
 //! tables are printed after criterion, with the ratio of the criterion medians.
 //!
-//! Run: `cargo bench -p jostle-compare --bench scale` (about 10 minutes);
+//! Run: `cargo bench -p jostle-compare --bench scale` (about 6 minutes on two cores);
 //! `SCALE_SCENES=piles_1000,rain_4000` runs only the named scenes. rapier3d's fastest
 //! configuration on this machine (issue 18) is its `simd8` feature built for the native CPU;
 //! the same run with both engines built that way:
