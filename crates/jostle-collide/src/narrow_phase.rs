@@ -705,6 +705,7 @@ impl NarrowPhase {
             settings,
             filter,
             dt,
+            turn: TurnBound::new(settings.reuse_angular),
         };
         let same_pairs = self.pairs.len() == pairs.len()
             && self
@@ -814,6 +815,8 @@ struct PairInputs<'a> {
     filter: Option<&'a PairFilter>,
     /// The step (s), finite and ≥ 0.
     dt: f32,
+    /// [`CollideSettings::reuse_angular`] as a bound for [`turned_less`].
+    turn: TurnBound,
 }
 
 /// Where [`update_pair`] writes: the update's outputs and scratch.
@@ -846,6 +849,7 @@ fn update_pair(
         settings,
         filter,
         dt,
+        ..
     } = *input;
     let (Some(c1), Some(c2)) = (colliders.get(state.pair.0), colliders.get(state.pair.1)) else {
         return false;
@@ -897,6 +901,7 @@ fn update_pair(
         &pos12,
         (shape_id(c1), shape_id(c2)),
         settings,
+        input.turn,
         prediction,
     );
     if reused {
@@ -917,7 +922,8 @@ fn update_pair(
     // Where the manifolds were kept and neither collider turned since every point's frame was
     // last checked, the held frames stand and no fresh one is built; else they are checked
     // now.
-    let held_only = reused && frames_still_held(state, (&pose1, &pose2, flip), settings);
+    let held_only =
+        reused && frames_still_held(state, (&pose1, &pose2, flip), settings, input.turn);
     if !held_only {
         state.checked = Some((pose1, pose2, flip));
     }
@@ -1017,14 +1023,15 @@ fn frames_still_held(
     state: &PairState,
     (pose1, pose2, flip): (&Pose, &Pose, bool),
     settings: &CollideSettings,
+    turn: TurnBound,
 ) -> bool {
     let Some((checked1, checked2, checked_flip)) = &state.checked else {
         return false;
     };
     *checked_flip == flip
         && settings.frame_tolerance > 0.0
-        && turned_less(checked1.rotation, pose1.rotation, settings.reuse_angular)
-        && turned_less(checked2.rotation, pose2.rotation, settings.reuse_angular)
+        && turned_less(checked1.rotation, pose1.rotation, turn)
+        && turned_less(checked2.rotation, pose2.rotation, turn)
         && state.manifolds.iter().all(|m| {
             m.points
                 .iter()
@@ -1032,12 +1039,24 @@ fn frames_still_held(
         })
 }
 
-/// Whether the unit rotation `now` is less than `angle` (rad) from `before`: compared through
-/// the sine of half the turn, the vector part of the relative rotation, which f32 resolves down
-/// to about 10⁻⁷ rad; through the cosine (`Quat::angle_between`) it reads any turn below about
-/// 5·10⁻⁴ rad as none.
-fn turned_less(before: Quat, now: Quat, angle: f32) -> bool {
-    (before.conjugate() * now).xyz().length() < (0.5 * angle).sin()
+/// A bound on a turn for [`turned_less`]: sin²(angle/2) of its angle, worked out once per
+/// update rather than three times per pair.
+#[derive(Clone, Copy, Debug)]
+struct TurnBound(f32);
+
+impl TurnBound {
+    fn new(angle: f32) -> Self {
+        let s = (0.5 * angle).sin();
+        Self(s * s)
+    }
+}
+
+/// Whether the unit rotation `now` is less than the bound's angle from `before`: compared
+/// through the sine of half the turn, the vector part of the relative rotation, which f32
+/// resolves down to about 10⁻⁷ rad; through the cosine (`Quat::angle_between`) it reads any
+/// turn below about 5·10⁻⁴ rad as none.
+fn turned_less(before: Quat, now: Quat, bound: TurnBound) -> bool {
+    (before.conjugate() * now).xyz().length_squared() < bound.0
 }
 
 /// Appends the contact of point `pt` with frame `frame` between bodies A and B, and where
@@ -1109,13 +1128,14 @@ fn reusable(
     pos12: &Pose,
     shapes: (usize, usize),
     settings: &CollideSettings,
+    turn: TurnBound,
     prediction: f32,
 ) -> bool {
     state.computed.as_ref().is_some_and(|c| {
         c.prediction == prediction
             && c.shapes == shapes
             && c.pos12.translation.distance(pos12.translation) < settings.reuse_linear
-            && turned_less(c.pos12.rotation, pos12.rotation, settings.reuse_angular)
+            && turned_less(c.pos12.rotation, pos12.rotation, turn)
     })
 }
 

@@ -8,6 +8,8 @@
 //!   layers 0.8 m apart, jittered and tilted from a fixed seed, raining into a walled square,
 //!   sleeping off;
 //! - `pyramid_40` (820 boxes), `pyramid3d_20` (2,870), `pyramid3d_30` (9,455), sleeping off;
+//!   and the two smaller pyramids whose time issue 15 compares with rapier3d's, `pyramid_20`
+//!   (210 boxes) and `pyramid3d_10` (385), so that their stages stand beside rapier3d's too;
 //! - `lattice_4000` (`assets/lattice_4000.ron`), sleeping on as the scene declares it.
 //!
 //! Each scene first runs its steps in both engines (the rains 300, the rest 120) with every
@@ -170,6 +172,8 @@ fn cases(smoke: bool) -> Vec<Case> {
     for n in [1000, 4000, 10_000, 20_000] {
         out.push(rain(n));
     }
+    out.push(pyramid(20));
+    out.push(pyramid3d(10));
     out.push(pyramid(40));
     out.push(pyramid3d(20));
     out.push(pyramid3d(30));
