@@ -938,21 +938,26 @@ fn update_pair(
         // (A normal that cannot be normalised gives no contact: the path below.)
         if held_only && !m.points.is_empty() && m.local_n1.try_normalize().is_some() {
             out.stats.manifolds += 1;
-            for (pi, pt) in m.points.iter().enumerate() {
-                // Every point has a held frame and lies within the prediction distance
-                // (`frames_still_held`).
-                let Some(frame) = pt.data.frame else {
-                    debug_assert!(false, "a point without a held frame in a held-only pair");
-                    continue;
-                };
-                touches |= pt.dist <= 0.0;
-                let slot = PointSlot {
+            // Every point has a held frame and lies within the prediction distance
+            // (`frames_still_held`): all are emitted, each list extended once per manifold
+            // (a resting 3D pyramid's narrow phase: 8% less than a push per point).
+            touches |= m.points.iter().any(|pt| pt.dist <= 0.0);
+            let (at_a, at_b) = (body_a.position, body_b.position);
+            out.contacts.extend(m.points.iter().map(|pt| {
+                debug_assert!(pt.data.frame.is_some(), "a held-only point without a frame");
+                let frame = pt.data.frame.unwrap_or(Frame {
+                    normal: Vec3::Y,
+                    r_a: Vec3::ZERO,
+                    r_b: Vec3::ZERO,
+                });
+                body_contact((a, b), (at_a, at_b), frame, pt, &material)
+            }));
+            out.slots
+                .extend((0..m.points.len() as u32).map(|point| PointSlot {
                     pair: pair_index,
                     manifold: mi as u32,
-                    point: pi as u32,
-                };
-                push_contact(out, slot, (a, b), (body_a, body_b), frame, pt, &material);
-            }
+                    point,
+                }));
             continue;
         }
         let w1 = m.subshape_pos1().map_or(pose1, |sub| pose1 * sub);
@@ -1070,11 +1075,31 @@ fn push_contact(
     pt: &parry3d::query::TrackedContact<PointData>,
     material: &Material,
 ) {
-    out.contacts.push(BodyContact {
+    out.contacts.push(body_contact(
+        (a, b),
+        (body_a.position, body_b.position),
+        frame,
+        pt,
+        material,
+    ));
+    out.slots.push(slot);
+}
+
+/// The contact of point `pt` with frame `frame` between bodies A and B, whose centres are at
+/// `at_a` and `at_b`.
+#[inline(always)]
+fn body_contact(
+    (a, b): (BodyHandle, BodyHandle),
+    (at_a, at_b): (Vec3, Vec3),
+    frame: Frame,
+    pt: &parry3d::query::TrackedContact<PointData>,
+    material: &Material,
+) -> BodyContact {
+    BodyContact {
         a,
         b,
-        point: body_a.position + frame.r_a,
-        point_b: body_b.position + frame.r_b,
+        point: at_a + frame.r_a,
+        point_b: at_b + frame.r_b,
         normal: frame.normal,
         penetration: -pt.dist,
         friction: material.friction,
@@ -1082,8 +1107,7 @@ fn push_contact(
         restitution: material.restitution,
         impulse: pt.data.impulse,
         preload: pt.data.preload,
-    });
-    out.slots.push(slot);
+    }
 }
 
 /// Walks two sorted, deduplicated lists together: `f(item, false)` for each item only in
