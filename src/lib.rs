@@ -32,6 +32,7 @@ pub mod scene;
 pub mod settings;
 pub mod snapshot;
 mod stages;
+mod threads;
 pub mod view;
 pub mod world;
 

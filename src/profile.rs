@@ -36,6 +36,9 @@ pub struct StepProfile {
     pub contact_points: usize,
     /// Manifolds reused because their pair's relative pose did not change.
     pub manifolds_reused: usize,
+    /// Parts the narrow phase's pairs were split into, one per thread that may run them (1
+    /// below a few hundred pairs or on one thread; [`jostle_collide::NarrowPhase::update_with`]).
+    pub narrow_parts: usize,
     /// Awake dynamic bodies at the end of the step.
     pub awake_bodies: usize,
     /// Sleeping dynamic bodies at the end of the step.

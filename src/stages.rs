@@ -20,6 +20,8 @@ const NO_SOLVER: u32 = u32::MAX;
 pub(crate) struct Scratch {
     /// Dense solver bodies; index 0 is the static entry.
     pub bodies: Vec<SolverBody>,
+    /// Runs the narrow phase's parts on the helper threads ([`crate::threads`]).
+    pub narrow_runner: crate::threads::TeamRunner,
     /// By body slot: how fast the step changed the body's pose, (|Δx|² + (2·sin(Δθ/2))²)/dt²
     /// (for sleep, [`jostle_sleep::update_motion`]).
     pub moved: Vec<f32>,

@@ -1459,16 +1459,18 @@ impl World {
         p.broad_phase += t.elapsed();
         p.candidate_pairs = pairs.len();
         let t = Stopwatch::start();
-        let stats = self.narrow.update_swept(
+        let stats = self.narrow.update_with(
             pairs,
             &self.colliders,
             &self.bodies,
             &self.settings.collide,
             self.pair_filter.as_deref(),
             dt,
+            &self.scratch.narrow_runner,
         );
         p.narrow_phase += t.elapsed();
         p.manifolds = stats.manifolds;
         p.manifolds_reused = stats.manifolds_reused;
+        p.narrow_parts = stats.parts;
     }
 }

@@ -34,8 +34,8 @@ pub use groups::CollisionGroups;
 pub use mass::{MassProps, mass_properties};
 pub use material::{Combine, Material};
 pub use narrow_phase::{
-    BodyContact, CollisionEvent, ContactForceEvent, NarrowPhase, NarrowStats, PairFilter,
-    SensorEvent,
+    BodyContact, CollisionEvent, ContactForceEvent, MAX_PARTS, NarrowPhase, NarrowStats, OneThread,
+    PairFilter, Runner, SensorEvent,
 };
 pub use parry3d;
 pub use parry3d::math::Pose;

@@ -143,6 +143,8 @@ pub struct NarrowStats {
     /// Manifolds (with at least one point) reused without recomputation because their pair's
     /// relative pose moved less than the reuse tolerances.
     pub manifolds_reused: usize,
+    /// Parts the pairs were split into ([`NarrowPhase::update_with`]; 1 on one thread).
+    pub parts: usize,
 }
 
 /// Per-point data kept in parry's manifolds.
@@ -270,9 +272,92 @@ pub struct NarrowPhase {
     /// otherwise [`NarrowPhase::find_force_events`] has nothing to look at.
     #[cfg_attr(feature = "serde", serde(skip))]
     any_threshold: bool,
-    /// Scratch: a recomputed pair's points before the update ([`compute`]).
+    /// Scratch: each part's outputs of an update ([`Part`]); the first part's lists are
+    /// the narrow phase's own, moved in and out.
     #[cfg_attr(feature = "serde", serde(skip))]
-    old_points_scratch: Vec<(PointKey, PointData)>,
+    parts: Vec<Part>,
+}
+
+/// Most parts an update's pairs are split into ([`Runner::parts`]).
+pub const MAX_PARTS: usize = 8;
+
+/// Runs an update's parts ([`NarrowPhase::update_with`]): a contiguous run of pairs each, with
+/// the same results whichever thread runs which part, and in whatever order.
+pub trait Runner: Sync {
+    /// How many parts to split an update of `pairs` pairs into (1 to [`MAX_PARTS`]; 1 runs
+    /// them on the calling thread alone).
+    fn parts(&self, pairs: usize) -> usize;
+    /// Calls `f(i)` once for every `i` in `0..n`, on any threads, and returns when every
+    /// call has returned.
+    fn run(&self, n: usize, f: &(dyn Fn(usize) + Sync));
+}
+
+/// A [`Runner`] that runs everything on the calling thread, in one part.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct OneThread;
+
+impl Runner for OneThread {
+    fn parts(&self, _pairs: usize) -> usize {
+        1
+    }
+    fn run(&self, n: usize, f: &(dyn Fn(usize) + Sync)) {
+        (0..n).for_each(f);
+    }
+}
+
+/// One part's outputs of an update: what [`PairOutputs`] writes, with the pair indices of
+/// its slots counted from the part's first kept pair, and whether each of its pairs is kept.
+#[derive(Clone, Debug, Default)]
+struct Part {
+    contacts: Vec<BodyContact>,
+    slots: Vec<PointSlot>,
+    touching: Vec<(BodyHandle, BodyHandle)>,
+    overlaps: Vec<(ColliderHandle, ColliderHandle)>,
+    any_threshold: bool,
+    stats: NarrowStats,
+    /// Scratch: a recomputed pair's points before the update ([`compute`]).
+    old_points: Vec<(PointKey, PointData)>,
+    /// Whether each pair of the part is kept.
+    keep: Vec<bool>,
+    /// Pairs kept.
+    kept: u32,
+}
+
+/// A part's pairs and outputs, for whichever thread runs it.
+type PartCell<'a> = std::sync::Mutex<Option<(&'a mut [PairState], &'a mut Part)>>;
+
+impl Part {
+    fn clear(&mut self) {
+        self.contacts.clear();
+        self.slots.clear();
+        self.touching.clear();
+        self.overlaps.clear();
+        self.any_threshold = false;
+        self.stats = NarrowStats::default();
+        self.keep.clear();
+        self.kept = 0;
+    }
+
+    /// Updates `states`, the part's pairs, in order.
+    fn update(&mut self, states: &mut [PairState], input: &PairInputs<'_>, min_cos: f32) {
+        let mut out = PairOutputs {
+            contacts: &mut self.contacts,
+            slots: &mut self.slots,
+            touching: &mut self.touching,
+            overlaps: &mut self.overlaps,
+            any_threshold: &mut self.any_threshold,
+            stats: &mut self.stats,
+            old_points: &mut self.old_points,
+            min_cos,
+        };
+        let mut kept = 0u32;
+        for state in states {
+            let keep = update_pair(state, kept, input, &mut out);
+            kept += u32::from(keep);
+            self.keep.push(keep);
+        }
+        self.kept = kept;
+    }
 }
 
 impl std::fmt::Debug for NarrowPhase {
@@ -666,6 +751,24 @@ impl NarrowPhase {
         filter: Option<&PairFilter>,
         dt: f32,
     ) -> NarrowStats {
+        self.update_with(pairs, colliders, bodies, settings, filter, dt, &OneThread)
+    }
+
+    /// [`NarrowPhase::update_swept`] with the pairs split into parts that `runner` may run on
+    /// several threads ([`Runner`]): each part updates a contiguous run of the pairs into its
+    /// own lists, which are then joined in order, so the results are bit for bit those of one
+    /// thread, however many parts and threads.
+    #[allow(clippy::too_many_arguments)]
+    pub fn update_with(
+        &mut self,
+        pairs: &[ColliderPair],
+        colliders: &ColliderSet,
+        bodies: &BodySet,
+        settings: &CollideSettings,
+        filter: Option<&PairFilter>,
+        dt: f32,
+        runner: &dyn Runner,
+    ) -> NarrowStats {
         let dt = if dt.is_finite() { dt.max(0.0) } else { 0.0 };
         let pairs: Cow<[ColliderPair]> = if pairs.windows(2).all(|w| w[0] < w[1]) {
             Cow::Borrowed(pairs)
@@ -675,30 +778,32 @@ impl NarrowPhase {
             sorted.dedup();
             Cow::Owned(sorted)
         };
-        let mut stats = NarrowStats {
-            candidate_pairs: pairs.len(),
-            ..NarrowStats::default()
-        };
-        self.contacts.clear();
-        self.slots.clear();
-        let min_cos = settings.frame_angle_tolerance.cos();
-        let mut touching = std::mem::take(&mut self.touching_scratch);
-        touching.clear();
-        let mut overlaps = std::mem::take(&mut self.overlaps_scratch);
-        overlaps.clear();
-        self.any_threshold = false;
+        let same_pairs = self.pairs.len() == pairs.len()
+            && self
+                .pairs
+                .iter()
+                .zip(pairs.iter())
+                .all(|(s, p)| s.pair == *p);
+        if !same_pairs {
+            // A state for each of the broad phase's pairs, in its order: the last update's
+            // where the pair is not new. (Where the pairs are the last update's, each state
+            // is updated where it is: moving every state into a new list cost a memmove per
+            // pair.)
+            let mut old_pairs = std::mem::replace(&mut self.pairs, std::mem::take(&mut self.spare));
+            self.pairs.clear();
+            self.pairs.reserve(pairs.len());
+            let mut old = old_pairs.drain(..).peekable();
+            for &pair in pairs.iter() {
+                while old.next_if(|s| s.pair < pair).is_some() {}
+                let state = old
+                    .next_if(|s| s.pair == pair)
+                    .unwrap_or_else(|| PairState::new(pair));
+                self.pairs.push(state);
+            }
+            drop(old);
+            self.spare = old_pairs;
+        }
 
-        let mut old_points = std::mem::take(&mut self.old_points_scratch);
-        let mut out = PairOutputs {
-            contacts: &mut self.contacts,
-            slots: &mut self.slots,
-            touching: &mut touching,
-            overlaps: &mut overlaps,
-            any_threshold: &mut self.any_threshold,
-            stats: &mut stats,
-            old_points: &mut old_points,
-            min_cos,
-        };
         let input = PairInputs {
             colliders,
             bodies,
@@ -707,41 +812,82 @@ impl NarrowPhase {
             dt,
             turn: TurnBound::new(settings.reuse_angular),
         };
-        let same_pairs = self.pairs.len() == pairs.len()
-            && self
-                .pairs
-                .iter()
-                .zip(pairs.iter())
-                .all(|(s, p)| s.pair == *p);
-        if same_pairs {
-            // The broad phase's pairs are last update's: each state is updated where it is
-            // (moving every state into a new list cost a memmove per pair). The same calls in
-            // the same order as below, so the same results.
-            let mut kept = 0u32;
-            self.pairs.retain_mut(|state| {
-                let keep = update_pair(state, kept, &input, &mut out);
-                kept += u32::from(keep);
-                keep
-            });
-        } else {
-            let mut old_pairs = std::mem::replace(&mut self.pairs, std::mem::take(&mut self.spare));
-            self.pairs.clear();
-            self.pairs.reserve(pairs.len());
-            let mut old = old_pairs.drain(..).peekable();
-            for &pair in pairs.iter() {
-                while old.next_if(|s| s.pair < pair).is_some() {}
-                let mut state = old
-                    .next_if(|s| s.pair == pair)
-                    .unwrap_or_else(|| PairState::new(pair));
-                let index = self.pairs.len() as u32;
-                if update_pair(&mut state, index, &input, &mut out) {
-                    self.pairs.push(state);
-                }
-            }
-            drop(old);
-            self.spare = old_pairs;
+        let min_cos = settings.frame_angle_tolerance.cos();
+        let n = self.pairs.len();
+        let per_part = n.div_ceil(runner.parts(n).clamp(1, MAX_PARTS)).max(1);
+        let count = n.div_ceil(per_part).max(1);
+        if self.parts.len() < count {
+            self.parts.resize_with(count, Part::default);
         }
-        self.old_points_scratch = old_points;
+        for part in &mut self.parts[..count] {
+            part.clear();
+        }
+        // The first part writes into the narrow phase's own lists (no copy for one part).
+        let first = &mut self.parts[0];
+        std::mem::swap(&mut first.contacts, &mut self.contacts);
+        std::mem::swap(&mut first.slots, &mut self.slots);
+        std::mem::swap(&mut first.touching, &mut self.touching_scratch);
+        std::mem::swap(&mut first.overlaps, &mut self.overlaps_scratch);
+        first.clear();
+        if count == 1 {
+            first.update(&mut self.pairs, &input, min_cos);
+        } else {
+            let cells: [PartCell<'_>; MAX_PARTS] =
+                std::array::from_fn(|_| std::sync::Mutex::new(None));
+            for ((cell, states), part) in cells
+                .iter()
+                .zip(self.pairs.chunks_mut(per_part))
+                .zip(self.parts.iter_mut())
+            {
+                *cell.lock().unwrap_or_else(|e| e.into_inner()) = Some((states, part));
+            }
+            runner.run(count, &|i| {
+                let Some(cell) = cells.get(i) else {
+                    return;
+                };
+                let mut guard = cell.lock().unwrap_or_else(|e| e.into_inner());
+                if let Some((states, part)) = guard.as_mut() {
+                    part.update(states, &input, min_cos);
+                }
+            });
+        }
+
+        // Join the parts in order: the slots of later parts count pairs from the first kept
+        // pair of all.
+        let (first, rest) = self.parts.split_at_mut(1);
+        let first = &mut first[0];
+        std::mem::swap(&mut first.contacts, &mut self.contacts);
+        std::mem::swap(&mut first.slots, &mut self.slots);
+        let mut touching = std::mem::take(&mut first.touching);
+        let mut overlaps = std::mem::take(&mut first.overlaps);
+        let mut stats = NarrowStats {
+            candidate_pairs: pairs.len(),
+            parts: count,
+            ..first.stats
+        };
+        self.any_threshold = first.any_threshold;
+        let mut offset = first.kept;
+        let mut all_kept = first.kept as usize == first.keep.len();
+        for part in &rest[..count - 1] {
+            self.contacts.extend_from_slice(&part.contacts);
+            self.slots.extend(part.slots.iter().map(|s| PointSlot {
+                pair: s.pair + offset,
+                ..*s
+            }));
+            touching.extend_from_slice(&part.touching);
+            overlaps.extend_from_slice(&part.overlaps);
+            self.any_threshold |= part.any_threshold;
+            stats.manifolds += part.stats.manifolds;
+            stats.manifolds_reused += part.stats.manifolds_reused;
+            offset += part.kept;
+            all_kept &= part.kept as usize == part.keep.len();
+        }
+        if !all_kept {
+            let mut keep = self.parts[..count]
+                .iter()
+                .flat_map(|p| p.keep.iter().copied());
+            self.pairs.retain(|_| keep.next().unwrap_or(false));
+        }
         stats.contact_points = self.contacts.len();
         self.update_events(touching, bodies);
         self.update_sensor_events(overlaps, colliders, bodies);
