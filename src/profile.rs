@@ -37,7 +37,8 @@ pub struct StepProfile {
     /// Manifolds reused because their pair's relative pose did not change.
     pub manifolds_reused: usize,
     /// Parts the narrow phase's pairs were split into, one per thread that may run them (1
-    /// below a few hundred pairs or on one thread; [`jostle_collide::NarrowPhase::update_with`]).
+    /// below 256 pairs, on one thread, or when the last step's substeps ran on one thread;
+    /// [`jostle_collide::NarrowPhase::update_with`]).
     pub narrow_parts: usize,
     /// Awake dynamic bodies at the end of the step.
     pub awake_bodies: usize,

@@ -1459,6 +1459,9 @@ impl World {
         p.broad_phase += t.elapsed();
         p.candidate_pairs = pairs.len();
         let t = Stopwatch::start();
+        self.scratch
+            .narrow_runner
+            .follow(self.profile.resolve_stats.threads);
         let stats = self.narrow.update_with(
             pairs,
             &self.colliders,
