@@ -95,7 +95,7 @@ pub fn frictionless_impulse(p: &PreparedContact) -> Vec3 {
 /// sliding velocity (seed lecture, "Computing Impulse"), then limit the step's **total**
 /// impulse `p.impulse + g` with [`coulomb_accumulated`]. A tangent direction nothing can move
 /// along (bodies kept in a plane by their locks) gets no friction and the rest is solved
-/// ([`without_dead_tangents`]). Falls back to [`frictionless_impulse`] when K is otherwise
+/// (`without_dead_tangents`). Falls back to [`frictionless_impulse`] when K is otherwise
 /// singular or the contact cannot be resolved.
 ///
 /// A contact that has applied no normal impulse this step and wants none (Δv ≤ 0) has no

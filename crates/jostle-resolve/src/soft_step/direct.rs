@@ -31,7 +31,7 @@
 //!    plain soft step solves no friction: friction the last relax pass left on a light body
 //!    is balanced by the normal load's distribution, and a biased solve that moves the load
 //!    without it spun a light box at 80 rad/s; each friction row with at least a small
-//!    compliance of its own, [`FRICTION_REGULARISATION`], as a face's friction rows are more
+//!    compliance of its own, `FRICTION_REGULARISATION`, as a face's friction rows are more
 //!    than the motions they span). An active set: normal rows whose total would
 //!    pull are fixed at no impulse, friction that would leave its cone is fixed on it, and
 //!    the rest is solved again. J·M⁻¹·Jᵀ is built in f64 from the rows and the bodies'
