@@ -687,7 +687,8 @@ impl World {
     /// Asks `filter` which collider pairs may make contact (or report sensor events), after
     /// their groups ([`PairFilter`]); `None` removes it. Every body wakes, so that pairs the
     /// new filter refuses part and pairs it admits meet. A snapshot does not keep the filter:
-    /// set it again on the restored world.
+    /// set it again on the restored world. In a large step it is asked from the narrow phase's
+    /// helper threads too, in any order ([`PairFilter`]).
     ///
     /// ```
     /// use jostle::{BodyDesc, ShapeDesc, Vec3, World, WorldSettings};

@@ -128,7 +128,8 @@ pub struct ContactForceEvent {
 
 /// A user's say on which collider pairs may make contact (or report sensor events), asked
 /// after their groups meet: `false` skips the pair. It must answer the same for the same
-/// pair until told otherwise, or contacts flicker.
+/// pair until told otherwise, or contacts flicker. It may be asked from several threads at
+/// once, in any order (the parts of [`NarrowPhase::update_with`]).
 pub type PairFilter = dyn Fn(&Collider, &Collider) -> bool + Send + Sync;
 
 /// Counts of one narrow-phase update.
