@@ -35,13 +35,6 @@ impl TeamRunner {
     }
 }
 
-impl Clone for TeamRunner {
-    /// A new runner (a team holds no results).
-    fn clone(&self) -> Self {
-        Self::default()
-    }
-}
-
 impl Runner for TeamRunner {
     fn parts(&self, pairs: usize) -> usize {
         if !self.active || pairs < PARALLEL_MIN_PAIRS {

@@ -820,18 +820,17 @@ impl NarrowPhase {
         if self.parts.len() < count {
             self.parts.resize_with(count, Part::default);
         }
-        for part in &mut self.parts[..count] {
-            part.clear();
-        }
         // The first part writes into the narrow phase's own lists (no copy for one part).
         let first = &mut self.parts[0];
         std::mem::swap(&mut first.contacts, &mut self.contacts);
         std::mem::swap(&mut first.slots, &mut self.slots);
         std::mem::swap(&mut first.touching, &mut self.touching_scratch);
         std::mem::swap(&mut first.overlaps, &mut self.overlaps_scratch);
-        first.clear();
+        for part in &mut self.parts[..count] {
+            part.clear();
+        }
         if count == 1 {
-            first.update(&mut self.pairs, &input, min_cos);
+            self.parts[0].update(&mut self.pairs, &input, min_cos);
         } else {
             let cells: [PartCell<'_>; MAX_PARTS] =
                 std::array::from_fn(|_| std::sync::Mutex::new(None));
