@@ -140,7 +140,8 @@ pub fn heavy_on_light(ratio: f32, n: u32, v: Variant) -> Case {
 /// What one run of a case measured.
 #[derive(Clone, Copy, Debug)]
 pub struct Outcome {
-    /// Largest horizontal displacement of any body between 2 s and the end (m).
+    /// Largest horizontal displacement of any body from where it was at 2 s, at any step
+    /// from then to the end (m).
     pub drift: f32,
     /// Deepest any body ends below its nominal resting height, per contact layer (m).
     pub sink_per_layer: f32,
@@ -269,6 +270,7 @@ pub fn measure(subject: &mut dyn Subject, nominal: &Nominal, layers: u32, second
     let start = subject.positions();
     let mut at_settle = start.clone();
     let mut penetration = 0.0f32;
+    let mut drift = 0.0f32;
     let mut times = Vec::with_capacity(steps);
     for step in 1..=steps {
         let t = Instant::now();
@@ -279,16 +281,14 @@ pub fn measure(subject: &mut dyn Subject, nominal: &Nominal, layers: u32, second
         }
         if step > settle {
             penetration = penetration.max(subject.penetration());
+            // Every step, not only the last: a column that sways back through its start by
+            // the end would otherwise count as still.
+            let now = subject.positions();
+            drift = drift.max(largest_sideways(&now, &at_settle));
         }
     }
     times.sort_by(f64::total_cmp);
     let end = subject.positions();
-    let sideways = |p: &Vec3, q: &Vec3| (*p - *q).with_y(0.0).length();
-    let drift = end
-        .iter()
-        .zip(&at_settle)
-        .map(|(p, q)| sideways(p, q))
-        .fold(0.0, f32::max);
     let sink = end
         .iter()
         .zip(&nominal.rest)
@@ -306,6 +306,19 @@ pub fn measure(subject: &mut dyn Subject, nominal: &Nominal, layers: u32, second
         ms_per_step: times.get(times.len() / 2).copied().unwrap_or(0.0),
         moved,
     }
+}
+
+/// Horizontal distance between two points (m).
+fn sideways(p: &Vec3, q: &Vec3) -> f32 {
+    (*p - *q).with_y(0.0).length()
+}
+
+/// The largest horizontal distance of any body in `now` from where it was in `then` (m).
+fn largest_sideways(now: &[Vec3], then: &[Vec3]) -> f32 {
+    now.iter()
+        .zip(then)
+        .map(|(p, q)| sideways(p, q))
+        .fold(0.0, f32::max)
 }
 
 /// The family of issue 15 at unit boxes, μ 0.5, exact starts: columns of 10, 20, 40, 60;
