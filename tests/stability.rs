@@ -343,7 +343,7 @@ fn stiffness_table() {
     }
 }
 
-/// `SoftStepSettings::block_relax` (an experiment, off by default): a column of 20 unit boxes
+/// `SoftStepSettings::block_relax` (the default, named here): a column of 20 unit boxes
 /// started at rest stands 10 s with its top never more than 1 cm sideways of its start, as
 /// point by point (2.4 mm, against 5.0; benches/RESULTS.md, "Each manifold's normal rows
 /// solved together").

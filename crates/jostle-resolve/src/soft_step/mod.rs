@@ -19,7 +19,8 @@
 //!    push-out of deep or unloaded overlap going to pseudo velocities; integrate velocities
 //!    (and the pseudo velocities, which are then cleared) into position and rotation deltas,
 //!    each body's angular momentum carried through its turn ([`gyroscopic`]);
-//!    relax (solve again without bias). Friction is solved in the relax pass only, unless
+//!    relax (solve again without bias; each manifold's normal rows as one system,
+//!    [`SoftStepSettings::block_relax`]). Friction is solved in the relax pass only, unless
 //!    [`SoftStepSettings::friction_in_bias_pass`] is set. After each pass the islands of
 //!    [`direct`] are solved exactly ([`direct::DirectIslands::correct`]), where Gauss-Seidel
 //!    would need about as many sweeps as their mass ratio. With [`PARALLEL_MIN_BATCHES`]

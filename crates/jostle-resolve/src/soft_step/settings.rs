@@ -96,11 +96,13 @@ pub struct SoftStepSettings {
     pub warm_start: bool,
     /// Solve each manifold's normal rows together in the relax pass: one small linear system
     /// per manifold (at most 4 × 4, regularised by a tenth of its diagonal, factored once per
-    /// step) instead of point after point. Default false: an experiment, measured and not the
-    /// default. On the stability family every one of the 42 cases meets the criterion with it
-    /// (the 60-box column sways 6.3 mm instead of 11.2), but a column of 15 started at rest
-    /// sways 13 cm within its first 2 s before it settles, and why it helps the columns is not
-    /// established (benches/RESULTS.md, "Each manifold's normal rows solved together").
+    /// step) instead of point after point, so that a face's points share its load as the
+    /// system does and not in the order they are solved. Default true. Measured against
+    /// point by point (the `jostle` crate's benches/RESULTS.md, "Each manifold's normal rows
+    /// solved together, the default"): columns of 5 to 60 boxes of 0.1, 1 and 10 m at μ 0.3,
+    /// 0.6 and 0.9, started at rest, all 504 keep every box within 7.3 mm of its start over
+    /// 20 s (point by point 437, and columns of 21, 43 and 49 boxes of 10 m fall); 8% more
+    /// time per step on the 20-row pyramid.
     pub block_relax: bool,
     /// Rigid contacts instead of springs. Default false.
     ///
@@ -183,7 +185,7 @@ impl Default for SoftStepSettings {
             gyroscopic: true,
             friction_in_bias_pass: false,
             warm_start: true,
-            block_relax: false,
+            block_relax: true,
             rigid_contacts: false,
             rigid_slop: 0.001,
             push_out_rate: 0.2,

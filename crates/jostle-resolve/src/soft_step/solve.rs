@@ -814,10 +814,15 @@ pub fn factor_blocks(batches: &mut Batches) {
     let Batches {
         manifolds, points, ..
     } = batches;
+    with_best_lanes!(factor_blocks_impl(manifolds, points) -> ())
+}
+
+#[inline(always)]
+fn factor_blocks_impl<F: Lane>(manifolds: &mut [ManifoldLanes<F>], points: &mut [PointLanes<F>]) {
     for m in manifolds.iter_mut() {
         let first = m.first as usize;
         let pts = &points[first..first + m.count as usize];
-        m.block = factor_block::<F8>(m, pts);
+        m.block = factor_block::<F>(m, pts);
     }
 }
 
@@ -883,8 +888,7 @@ fn factor_block<F: Lane>(m: &ManifoldLanes<F>, points: &[PointLanes<F>]) -> [F; 
 /// The relax pass over one batch with each manifold's normal rows solved together: the
 /// impulses x of all its points at once from (K + ε·diag K)·x = −(vₙ + bias), K = J·M⁻¹·Jᵀ
 /// over the manifold's points (factored once per step, [`factor_blocks`]), then each point's
-/// friction in order ([`super::SoftStepSettings::block_relax`], an experiment).
-#[allow(clippy::needless_range_loop)]
+/// friction in order ([`super::SoftStepSettings::block_relax`]).
 #[inline(always)]
 fn relax_block<F: Lane, L: LinearResponse<F>>(
     m: &ManifoldLanes<F>,
@@ -893,14 +897,32 @@ fn relax_block<F: Lane, L: LinearResponse<F>>(
     states: &[Shared<BodyState>],
     inv_h: F,
 ) {
+    let x = block_impulses(m, pair, points, states, inv_h);
+    let pulls = apply_block(pair, points, &x);
+    let fallback = pulls.any();
+    for p in points.iter_mut() {
+        block_point_rest(m, pair, p, pulls, fallback, inv_h);
+    }
+}
+
+/// The block's normal impulse changes x for the batch's points at the pair's velocities now
+/// (each point's separation stored on the way).
+#[allow(clippy::needless_range_loop)]
+#[inline(always)]
+fn block_impulses<F: Lane, L: LinearResponse<F>>(
+    m: &ManifoldLanes<F>,
+    pair: &Pair<F, L>,
+    points: &mut [PointLanes<F>],
+    states: &[Shared<BodyState>],
+    inv_h: F,
+) -> [F; MAX_POINTS] {
     store_separations(m, points, states);
-    let n = points.len().min(MAX_POINTS);
     let mut b = [F::ZERO; MAX_POINTS];
     // The block serves lanes with two or more points (a single point's row is exact point by
     // point, and the regularisation would only under-relax it). A speculative point keeps its
     // gap rule in the block: its bias s/h, which K need not be able to produce; excluding such
     // lanes instead (solved point by point) let the column of 10 m boxes sway 1.4 m.
-    for (i, p) in points.iter().take(n).enumerate() {
+    for (i, p) in points.iter().take(MAX_POINTS).enumerate() {
         // A padding point's row is zero: its right-hand side too.
         b[i] = F::select(
             p.normal_mass.cmpgt(F::ZERO),
@@ -908,14 +930,12 @@ fn relax_block<F: Lane, L: LinearResponse<F>>(
             F::ZERO,
         );
     }
-    let single = match points.get(1) {
-        Some(p) => p.normal_mass.cmple(F::ZERO),
-        None => F::ZERO.cmple(F::ZERO),
-    };
-    // L·y = −b, then Lᵀ·x = y.
+    // L·y = −b, then Lᵀ·x = y, over all MAX_POINTS rows: a row past the batch's points has
+    // b = 0 and a zero factor (`factor_block` leaves it so), hence x = 0, and fixed bounds let
+    // the loops unroll into registers.
     let l = &m.block;
     let mut y = [F::ZERO; MAX_POINTS];
-    for i in 0..n {
+    for i in 0..MAX_POINTS {
         let mut s = F::ZERO - b[i];
         for q in 0..i {
             s = s - l[below(i, q)] * y[q];
@@ -923,33 +943,58 @@ fn relax_block<F: Lane, L: LinearResponse<F>>(
         y[i] = s * l[6 + i];
     }
     let mut x = [F::ZERO; MAX_POINTS];
-    for i in (0..n).rev() {
+    for i in (0..MAX_POINTS).rev() {
         let mut s = y[i];
-        for q in i + 1..n {
+        for q in i + 1..MAX_POINTS {
             s = s - l[below(q, i)] * x[q];
         }
         x[i] = s * l[6 + i];
     }
-    // `pulls` marks the lanes solved point by point instead: a lane the block does not serve,
-    // or one where some point's total would pull. Clamping that point alone would turn the
-    // opposite impulses of a face's twist (which the system leaves nearly free) into a net
-    // push, so such a lane takes none of the block's impulses.
+    x
+}
+
+/// Applies the block's impulses `x` to the lanes that take them; returns the lanes solved
+/// point by point instead (`pulls`): a lane the block does not serve (a single point), or
+/// one where some point's total would pull. Clamping that point alone would turn the
+/// opposite impulses of a face's twist (which the system leaves nearly free) into a net
+/// push, so such a lane takes none of the block's impulses.
+#[inline(always)]
+fn apply_block<F: Lane, L: LinearResponse<F>>(
+    pair: &mut Pair<F, L>,
+    points: &mut [PointLanes<F>],
+    x: &[F; MAX_POINTS],
+) -> F::Mask {
+    let single = match points.get(1) {
+        Some(p) => p.normal_mass.cmple(F::ZERO),
+        None => F::ZERO.cmple(F::ZERO),
+    };
     let mut pulls = single;
-    for (p, &dx) in points.iter().zip(&x).take(n) {
+    for (p, &dx) in points.iter().zip(x) {
         pulls = pulls | (p.normal_impulse + dx).cmplt(F::ZERO);
     }
-    for (p, &dx) in points.iter_mut().zip(&x).take(n) {
+    for (p, &dx) in points.iter_mut().zip(x) {
         accumulate_normal(pair, p, F::select(pulls, F::ZERO, dx));
     }
-    let fallback = pulls.any();
-    for p in points.iter_mut() {
-        if fallback {
-            let gs = rigid_row(pair, p, p.separation, inv_h);
-            accumulate_normal(pair, p, F::select(pulls, gs, F::ZERO));
-        }
-        if m.friction {
-            solve_friction(pair, p);
-        }
+    pulls
+}
+
+/// What follows the block for one point: its normal row point by point in the lanes of
+/// `pulls` (when `fallback`, some lane is), then its friction.
+#[inline(always)]
+fn block_point_rest<F: Lane, L: LinearResponse<F>>(
+    m: &ManifoldLanes<F>,
+    pair: &mut Pair<F, L>,
+    p: &mut PointLanes<F>,
+    pulls: F::Mask,
+    fallback: bool,
+    inv_h: F,
+) {
+    if fallback {
+        let gs = rigid_row(pair, p, p.separation, inv_h);
+        accumulate_normal(pair, p, F::select(pulls, gs, F::ZERO));
+    }
+    if m.friction {
+        solve_friction(pair, p);
     }
 }
 
@@ -1289,7 +1334,8 @@ fn relax_impl<F: Lane>(
 ) {
     let mut rest = manifolds;
     if block {
-        // Block relax (`SoftStepSettings::block_relax`).
+        // Block relax (`SoftStepSettings::block_relax`). (Two batches interleaved, as below,
+        // measured no faster here.)
         let inv_h_lanes = F::splat(inv_h);
         for_each_batch!(
             manifolds,
