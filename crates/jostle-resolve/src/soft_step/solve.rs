@@ -964,9 +964,13 @@ fn apply_block<F: Lane, L: LinearResponse<F>>(
     points: &mut [PointLanes<F>],
     x: &[F; MAX_POINTS],
 ) -> F::Mask {
-    let single = match points.get(1) {
-        Some(p) => p.normal_mass.cmple(F::ZERO),
-        None => F::ZERO.cmple(F::ZERO),
+    // A lane of one point; not a padding lane (no point at all), which takes no impulse
+    // either way, so that a batch with one does not fall back point by point for it.
+    let single = match (points.first(), points.get(1)) {
+        (Some(first), Some(second)) => {
+            second.normal_mass.cmple(F::ZERO) & first.normal_mass.cmpgt(F::ZERO)
+        }
+        _ => F::ZERO.cmple(F::ZERO),
     };
     let mut pulls = single;
     for (p, &dx) in points.iter().zip(x) {
