@@ -669,13 +669,13 @@ impl Solver {
     fn energy_change(&self, rows: &[Row], couplings: &[f64], states: &[BodyState]) -> f64 {
         let all = rows.len();
         let mut change = 0.0;
+        // A row left out has no change, so the couplings need not skip it.
+        debug_assert!((0..all).all(|k| self.role[k] != Role::Out || self.change[k] == 0.0));
         for (i, row) in rows.iter().enumerate() {
             if self.role[i] == Role::Out {
                 continue;
             }
             let x = self.change[i];
-            debug_assert!((0..all).all(|k| self.role[k] != Role::Out || self.change[k] == 0.0));
-            // (A row left out has no change.)
             let coupled = dot(&couplings[i * all..(i + 1) * all], &self.change);
             change += x * (f64::from(row.velocity(states)) + 0.5 * coupled);
         }
@@ -847,11 +847,10 @@ impl Row {
 /// Factorises the symmetric positive semi-definite `a` (n × n, row-major, the lower
 /// triangle read) in place as L·Lᵀ, L's diagonal stored as its reciprocals 1/lᵢᵢ (the
 /// substitution then multiplies where it would divide). A row whose pivot falls below
-/// [`DEPENDENT`] times its
-/// diagonal depends on the rows before it (the rows of a face span fewer motions than it
-/// has points): its column of L is zero, and [`cholesky_substitute`] gives it no impulse
-/// while the others meet it as far as it is consistent with them. False when a pivot is
-/// not finite.
+/// [`DEPENDENT`] times its diagonal depends on the rows before it (the rows of a face span
+/// fewer motions than it has points): its column of L is zero, and [`cholesky_substitute`]
+/// gives it no impulse while the others meet it as far as it is consistent with them. False
+/// when a pivot is not finite.
 fn cholesky_factor(a: &mut [f64], n: usize) -> bool {
     debug_assert!(a.len() >= n * n);
     for j in 0..n {

@@ -889,6 +889,7 @@ fn factor_block<F: Lane>(m: &ManifoldLanes<F>, points: &[PointLanes<F>]) -> [F; 
 /// impulses x of all its points at once from (K + ε·diag K)·x = −(vₙ + bias), K = J·M⁻¹·Jᵀ
 /// over the manifold's points (factored once per step, [`factor_blocks`]), then each point's
 /// friction in order ([`super::SoftStepSettings::block_relax`]).
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 fn relax_block<F: Lane, L: LinearResponse<F>>(
     m: &ManifoldLanes<F>,
@@ -897,25 +898,6 @@ fn relax_block<F: Lane, L: LinearResponse<F>>(
     states: &[Shared<BodyState>],
     inv_h: F,
 ) {
-    let x = block_impulses(m, pair, points, states, inv_h);
-    let pulls = apply_block(pair, points, &x);
-    let fallback = pulls.any();
-    for p in points.iter_mut() {
-        block_point_rest(m, pair, p, pulls, fallback, inv_h);
-    }
-}
-
-/// The block's normal impulse changes x for the batch's points at the pair's velocities now
-/// (each point's separation stored on the way).
-#[allow(clippy::needless_range_loop)]
-#[inline(always)]
-fn block_impulses<F: Lane, L: LinearResponse<F>>(
-    m: &ManifoldLanes<F>,
-    pair: &Pair<F, L>,
-    points: &mut [PointLanes<F>],
-    states: &[Shared<BodyState>],
-    inv_h: F,
-) -> [F; MAX_POINTS] {
     store_separations(m, points, states);
     let mut b = [F::ZERO; MAX_POINTS];
     // The block serves lanes with two or more points (a single point's row is exact point by
@@ -930,6 +912,14 @@ fn block_impulses<F: Lane, L: LinearResponse<F>>(
             F::ZERO,
         );
     }
+    // A lane of one point; not a padding lane (no point at all), which takes no impulse
+    // either way, so that a batch with one does not fall back point by point for it.
+    let single = match (points.first(), points.get(1)) {
+        (Some(first), Some(second)) => {
+            second.normal_mass.cmple(F::ZERO) & first.normal_mass.cmpgt(F::ZERO)
+        }
+        _ => F::ZERO.cmple(F::ZERO),
+    };
     // L·y = −b, then Lᵀ·x = y, over all MAX_POINTS rows: a row past the batch's points has
     // b = 0 and a zero factor (`factor_block` leaves it so), hence x = 0, and fixed bounds let
     // the loops unroll into registers.
@@ -950,55 +940,26 @@ fn block_impulses<F: Lane, L: LinearResponse<F>>(
         }
         x[i] = s * l[6 + i];
     }
-    x
-}
-
-/// Applies the block's impulses `x` to the lanes that take them; returns the lanes solved
-/// point by point instead (`pulls`): a lane the block does not serve (a single point), or
-/// one where some point's total would pull. Clamping that point alone would turn the
-/// opposite impulses of a face's twist (which the system leaves nearly free) into a net
-/// push, so such a lane takes none of the block's impulses.
-#[inline(always)]
-fn apply_block<F: Lane, L: LinearResponse<F>>(
-    pair: &mut Pair<F, L>,
-    points: &mut [PointLanes<F>],
-    x: &[F; MAX_POINTS],
-) -> F::Mask {
-    // A lane of one point; not a padding lane (no point at all), which takes no impulse
-    // either way, so that a batch with one does not fall back point by point for it.
-    let single = match (points.first(), points.get(1)) {
-        (Some(first), Some(second)) => {
-            second.normal_mass.cmple(F::ZERO) & first.normal_mass.cmpgt(F::ZERO)
-        }
-        _ => F::ZERO.cmple(F::ZERO),
-    };
+    // `pulls` marks the lanes solved point by point instead: a lane the block does not serve,
+    // or one where some point's total would pull. Clamping that point alone would turn the
+    // opposite impulses of a face's twist (which the system leaves nearly free) into a net
+    // push, so such a lane takes none of the block's impulses.
     let mut pulls = single;
-    for (p, &dx) in points.iter().zip(x) {
+    for (p, &dx) in points.iter().zip(&x) {
         pulls = pulls | (p.normal_impulse + dx).cmplt(F::ZERO);
     }
-    for (p, &dx) in points.iter_mut().zip(x) {
+    for (p, &dx) in points.iter_mut().zip(&x) {
         accumulate_normal(pair, p, F::select(pulls, F::ZERO, dx));
     }
-    pulls
-}
-
-/// What follows the block for one point: its normal row point by point in the lanes of
-/// `pulls` (when `fallback`, some lane is), then its friction.
-#[inline(always)]
-fn block_point_rest<F: Lane, L: LinearResponse<F>>(
-    m: &ManifoldLanes<F>,
-    pair: &mut Pair<F, L>,
-    p: &mut PointLanes<F>,
-    pulls: F::Mask,
-    fallback: bool,
-    inv_h: F,
-) {
-    if fallback {
-        let gs = rigid_row(pair, p, p.separation, inv_h);
-        accumulate_normal(pair, p, F::select(pulls, gs, F::ZERO));
-    }
-    if m.friction {
-        solve_friction(pair, p);
+    let fallback = pulls.any();
+    for p in points.iter_mut() {
+        if fallback {
+            let gs = rigid_row(pair, p, p.separation, inv_h);
+            accumulate_normal(pair, p, F::select(pulls, gs, F::ZERO));
+        }
+        if m.friction {
+            solve_friction(pair, p);
+        }
     }
 }
 
