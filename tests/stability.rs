@@ -123,7 +123,7 @@ fn a_20_row_pyramid_stands_still_for_20_s() {
 }
 
 /// Issue 17 item 3: the Millington resolver warm started from the previous step's impulses
-/// (`MillingtonSettings::warm_start`) holds the running-bond wall and the 385-box 3D pyramid
+/// (`MillingtonSettings::warm_start`, the default) holds the running-bond wall and the 385-box 3D pyramid
 /// at the stability criterion, where the same resolver started cold runs out of its pick
 /// budget at every step and lets the wall creep (benches/RESULTS.md, "The Millington
 /// resolver warm started").

@@ -11,9 +11,14 @@
 //!    projection ([`position`]), updating the penetration of every contact sharing a body;
 //! 4. the **velocity pass**: per island, worst velocity change first (the desired normal
 //!    change, or the sliding speed of a contact whose friction can still act), an impulse per
-//!    pick ([`velocity`]), updating the closing velocity of every contact sharing a body;
+//!    pick ([`velocity`]), updating the closing velocity of every contact sharing a body,
+//!    warm started from the impulses the contacts carried from the last step;
 //! 5. integrate the resolved velocities into poses
 //!    ([`crate::integrate::integrate_positions`]).
+//!
+//! After each of the two passes, in islands that hold a mass ratio of 10 or more, the **shock
+//! sweep** ([`shock`]) resolves what the picks left, from the ground up with each lower body
+//! held still.
 //!
 //! Speculative contacts (negative penetration, within the collision layer's prediction margin)
 //! take part only when their gap closes within the step (see [`desired_delta_velocity`]), so
@@ -64,6 +69,7 @@ pub mod position;
 pub mod prepare;
 pub mod priority_queue;
 pub mod settings;
+pub mod shock;
 pub mod velocity;
 mod worst_first;
 
@@ -87,6 +93,7 @@ use crate::integrate::{integrate_positions, integrate_velocities};
 use crate::{Contact, ResolveStats, Resolver, SolverBody, StepContext};
 use islands::Islands;
 use passes::{PositionPass, VelocityPass};
+use shock::Shock;
 pub use worst_first::PickWork;
 use worst_first::{PickScratch, run_islands};
 
@@ -95,10 +102,12 @@ use worst_first::{PickScratch, run_islands};
 /// [`MillingtonSettings::warm_start`] it reads the impulses the contacts carry, as any
 /// resolver may), so swapping it in or out mid-simulation is safe.
 ///
-/// Warm starting is off by default. On resting stacks it makes the velocity pass converge
-/// within a tenth of its budget (the 20-row pyramid: 61 ms → 1.9 ms per step), but with it a
-/// 1 kg box under 10⁶ kg is pushed through the floor, which the default must not do
-/// (benches/RESULTS.md, "The Millington resolver warm started").
+/// Warm starting is on by default: on resting stacks it makes the velocity pass converge
+/// within its budget (the 20-row pyramid: 53 ms → 0.8 ms per step, the 3D pyramid of 10:
+/// 223 → 3.5 ms, both drifting less). The shock sweep ([`shock`]) holds what the picks cannot:
+/// a box under one 10 or more times heavier, which warm started alone was pushed through the
+/// floor at 1:10⁶ (benches/RESULTS.md, "The shock sweep, and the Millington resolver warm
+/// started by default").
 #[derive(Clone, Debug, Default)]
 pub struct MillingtonResolver {
     /// The settings used by the next step; change them freely between steps.
@@ -114,6 +123,8 @@ pub struct MillingtonResolver {
     /// bodies this step (scratch for `bound_bounce_energy`).
     before_velocity: Vec<(jostle_math::Vec3, jostle_math::Vec3)>,
     bounce_marks: Vec<u8>,
+    /// The shock sweep's levels and order ([`shock`]).
+    shock: Shock,
 }
 
 /// [`MillingtonResolver`]'s bounce marks: the body bounces off an immovable body.
@@ -182,14 +193,15 @@ impl MillingtonResolver {
             bodies,
             settings,
         };
-        stats.position_iterations = run_islands(
+        self.shock.reset();
+        stats.position_iterations = run_pass(
             &mut pass,
             &self.islands,
             &mut self.scratch,
-            settings.pick,
+            &mut self.shock,
+            settings,
             &settings.position_iterations,
             settings.position_epsilon,
-            settings.first_sweep,
         );
         stats.position_residual = self.scratch.residual;
         self.work[0] = std::mem::take(&mut self.scratch.work);
@@ -254,14 +266,14 @@ impl MillingtonResolver {
             velocity_epsilon: settings.velocity_epsilon,
             picked: u32::MAX,
         };
-        stats.velocity_iterations = run_islands(
+        stats.velocity_iterations = run_pass(
             &mut pass,
             &self.islands,
             &mut self.scratch,
-            settings.pick,
+            &mut self.shock,
+            settings,
             &settings.velocity_iterations,
             settings.velocity_epsilon,
-            settings.first_sweep,
         );
         stats.velocity_residual = self.scratch.residual;
         self.work[1] = std::mem::take(&mut self.scratch.work);
@@ -305,6 +317,34 @@ impl Resolver for MillingtonResolver {
         stats.threads = 1;
         stats
     }
+}
+
+/// One pass: the worst-first picks over every island ([`run_islands`]), then the shock
+/// sweep ([`shock`]) when it is on and the picks left a key above `epsilon`. Returns the
+/// picks and the sweep's resolutions together.
+fn run_pass<P: worst_first::Pass>(
+    pass: &mut P,
+    islands: &Islands,
+    scratch: &mut PickScratch,
+    shock: &mut Shock,
+    settings: &MillingtonSettings,
+    budget: &settings::IterationBudget,
+    epsilon: f32,
+) -> u32 {
+    let mut picks = run_islands(
+        pass,
+        islands,
+        scratch,
+        settings.pick,
+        budget,
+        epsilon,
+        settings.first_sweep,
+    );
+    if settings.shock_sweep && scratch.residual > epsilon {
+        shock.prepare(pass.contacts(), islands, pass.bodies());
+        picks += shock.sweep(pass, islands, scratch, epsilon);
+    }
+    picks
 }
 
 /// The warm start of the velocity pass ([`MillingtonSettings::warm_start`]): each resting

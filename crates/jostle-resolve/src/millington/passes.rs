@@ -5,7 +5,7 @@ use super::change::BodyChange;
 use super::position::{position_key, resolvable, resolve_penetration, update_penetration};
 use super::prepare::PreparedContact;
 use super::settings::MillingtonSettings;
-use super::velocity::{reopen_friction, resolve_velocity, update_velocity, velocity_key};
+use super::velocity::{reopen_friction, resolve_velocity, update_velocity_for, velocity_key};
 use super::worst_first::Pass;
 use crate::SolverBody;
 
@@ -18,6 +18,14 @@ pub(crate) struct PositionPass<'a> {
 }
 
 impl Pass for PositionPass<'_> {
+    fn contacts(&self) -> &[PreparedContact] {
+        self.contacts
+    }
+
+    fn bodies(&self) -> &[SolverBody] {
+        self.bodies
+    }
+
     #[inline]
     fn key(&self, contact: u32) -> f32 {
         let p = &self.contacts[contact as usize];
@@ -34,6 +42,14 @@ impl Pass for PositionPass<'_> {
             self.bodies,
             self.settings,
         )
+    }
+
+    fn resolve_held(&mut self, contact: u32, side: usize) -> Option<BodyChange> {
+        let p = &mut self.contacts[contact as usize];
+        let mut held = p.with_side_held(side, self.bodies);
+        let change = resolve_penetration(&mut held, self.bodies, self.settings);
+        p.take_resolved(&held);
+        change
     }
 
     #[inline]
@@ -54,6 +70,14 @@ pub(crate) struct VelocityPass<'a> {
 }
 
 impl Pass for VelocityPass<'_> {
+    fn contacts(&self) -> &[PreparedContact] {
+        self.contacts
+    }
+
+    fn bodies(&self) -> &[SolverBody] {
+        self.bodies
+    }
+
     /// [`velocity_key`]: the desired normal change, or the sliding speed while the contact's
     /// friction can still remove it (fix of the original; see its rustdoc).
     #[inline]
@@ -69,12 +93,51 @@ impl Pass for VelocityPass<'_> {
         ))
     }
 
+    /// Not applied (`None`) where it would give the moving body kinetic energy: held
+    /// still, the lower body gives none of its own back, so a pick that speeds the upper
+    /// body up (a body thrown onto one moving towards it) would create energy.
+    fn resolve_held(&mut self, contact: u32, side: usize) -> Option<BodyChange> {
+        let p = &mut self.contacts[contact as usize];
+        let mut held = p.with_side_held(side, self.bodies);
+        let moving = held.body[1 - side] as usize;
+        let r = held.r[1 - side];
+        let before = self.bodies.get(moving).copied()?;
+        let change = resolve_velocity(&mut held, self.bodies);
+        // ΔE = J·(u + ½Δu): J the impulse on the moving body at its point, u the point's
+        // velocity before and Δu its change.
+        let impulse = held.basis * (held.impulse - p.impulse);
+        let impulse = if side == 1 { impulse } else { -impulse };
+        let u = before.linear_velocity + before.angular_velocity.cross(r);
+        let du = change.point_change(moving as u32, r).unwrap_or_default();
+        if !(impulse.dot(u + 0.5 * du) <= 0.0) {
+            self.bodies[moving] = before;
+            return None;
+        }
+        self.picked = contact;
+        p.take_resolved(&held);
+        Some(change)
+    }
+
+    /// A bouncing contact (a target separating speed of at least the velocity limit, below
+    /// which no contact bounces) is left to the worst-first picks: held still, its other body
+    /// would bounce off a body that does not give.
+    #[inline]
+    fn sweeps_held(&self, contact: u32) -> bool {
+        self.contacts[contact as usize].target_velocity < self.velocity_limit
+    }
+
     /// [`update_velocity`], then [`reopen_friction`] for a contact that shares a body with
     /// the change.
     #[inline]
     fn update(&mut self, contact: u32, change: &BodyChange) {
+        // The pair the change was made for: the picked contact's sides, even where the
+        // pick held one of them still.
+        let pair = self
+            .contacts
+            .get(self.picked as usize)
+            .map_or(change.body, |picked| picked.body);
         let p = &mut self.contacts[contact as usize];
-        if update_velocity(p, change, self.velocity_limit) {
+        if update_velocity_for(p, change, pair, self.velocity_limit) {
             reopen_friction(p, contact == self.picked, self.velocity_epsilon);
         }
     }

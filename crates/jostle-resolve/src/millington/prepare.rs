@@ -149,6 +149,36 @@ impl PreparedContact {
     pub fn is_active(&self) -> bool {
         self.body[0] != NO_BODY || self.body[1] != NO_BODY
     }
+
+    /// This contact with the body on `side` (0 = A, 1 = B) held still, as the shock sweep
+    /// resolves it ([`super::shock`]): that side is [`NO_BODY`] and the inertias are the
+    /// other side's alone.
+    pub fn with_side_held(&self, side: usize, bodies: &[SolverBody]) -> Self {
+        let mut held = *self;
+        held.body[side] = NO_BODY;
+        let other = 1 - side;
+        let n = held.normal();
+        (held.normal_inertia, held.linear_inertia) = match held.side_body(bodies, other) {
+            Some(b) => {
+                let along = b.inv_mass_along(n);
+                (along + angular_inertia(b, held.r[other], n), along)
+            }
+            None => (0.0, 0.0),
+        };
+        held
+    }
+
+    /// Takes what resolving `held` (this contact with a side held,
+    /// [`PreparedContact::with_side_held`]) changed, keeping this contact's own sides and
+    /// inertias.
+    pub fn take_resolved(&mut self, held: &Self) {
+        let (body, normal_inertia, linear_inertia) =
+            (self.body, self.normal_inertia, self.linear_inertia);
+        *self = *held;
+        self.body = body;
+        self.normal_inertia = normal_inertia;
+        self.linear_inertia = linear_inertia;
+    }
 }
 
 /// The desired normal velocity change of the micro-collision rule (seed lecture, "Remove

@@ -163,12 +163,19 @@ pub struct MillingtonSettings {
     /// than `velocity_limit`) applies its carried impulse, clamped to a push and to its
     /// friction cone, before the first pick, and keeps its target (touching, or closing its
     /// gap) for the whole step, taking back what its neighbours' picks make too much.
-    /// Default false (see [`MillingtonResolver`](super::MillingtonResolver)).
+    /// Default true (see [`MillingtonResolver`](super::MillingtonResolver)).
     pub warm_start: bool,
     /// Both passes first resolve every contact once, in order, before they pick worst-first
     /// (the lecture: "run through the entire list once, then prioritise"), out of the same
     /// budget. Default false.
     pub first_sweep: bool,
+    /// After each pass's worst-first picks, when a contact is still above the pass's
+    /// epsilon, resolve what is left from the ground up with each lower body held still, in
+    /// islands that hold a mass ratio of [`super::shock::SHOCK_MASS_RATIO`] or more (shock
+    /// propagation, [`super::shock`]). Default true: without it a light body under a much
+    /// heavier one is squeezed out or pushed through the floor (a 1 kg box under 10⁶ kg),
+    /// because each pick passes on only about m/M of the load.
+    pub shock_sweep: bool,
 }
 
 impl MillingtonSettings {
@@ -266,8 +273,9 @@ impl Default for MillingtonSettings {
             relaxation: 1.0,
             projection: Projection::Nonlinear,
             pick: PickStrategy::Heap,
-            warm_start: false,
+            warm_start: true,
             first_sweep: false,
+            shock_sweep: true,
         }
     }
 }

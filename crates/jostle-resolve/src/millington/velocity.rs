@@ -419,6 +419,19 @@ pub fn resolve_velocity(p: &mut PreparedContact, bodies: &mut [SolverBody]) -> B
 /// micro-collision rule from the new velocity (a push only).
 /// Returns whether `p` shared a body with the change.
 pub fn update_velocity(p: &mut PreparedContact, change: &BodyChange, velocity_limit: f32) -> bool {
+    update_velocity_for(p, change, change.body, velocity_limit)
+}
+
+/// [`update_velocity`] after a pick of the contact between the bodies `pair` (its sides as
+/// the contact has them): a pick with one side held still
+/// ([`PreparedContact::with_side_held`]) changes only the other body, but it is still a pick
+/// of that pair for the pair's other points.
+pub fn update_velocity_for(
+    p: &mut PreparedContact,
+    change: &BodyChange,
+    pair: [u32; 2],
+    velocity_limit: f32,
+) -> bool {
     let mut touched = false;
     if let Some(d) = change.point_change(p.body[0], p.r[0]) {
         p.velocity += p.basis.transpose() * d;
@@ -429,7 +442,7 @@ pub fn update_velocity(p: &mut PreparedContact, change: &BodyChange, velocity_li
         touched = true;
     }
     if touched {
-        let same_pair = change.body == p.body || change.body == [p.body[1], p.body[0]];
+        let same_pair = pair == p.body || pair == [p.body[1], p.body[0]];
         if !same_pair && !p.held {
             // A new collision, or nothing to do: what the other pair's pick left is kept
             // unless the micro-collision rule wants a push.

@@ -12,7 +12,9 @@
 
 use super::change::BodyChange;
 use super::islands::Islands;
+use super::prepare::PreparedContact;
 use super::priority_queue::IndexedMaxHeap;
+use crate::SolverBody;
 
 /// What the worst-first loops did, counted as they run (a few integer additions per pick, so
 /// always on): the evidence that a heap pick costs O(degree · log n) and a rescan O(n),
@@ -49,8 +51,19 @@ pub(crate) trait Pass {
     fn key(&self, contact: u32) -> f32;
     /// Resolves the contact, moving its bodies; `None` if nothing could move.
     fn resolve(&mut self, contact: u32) -> Option<BodyChange>;
+    /// Resolves the contact with the body on `side` held still
+    /// ([`super::prepare::PreparedContact::with_side_held`]): only the other body moves.
+    fn resolve_held(&mut self, contact: u32, side: usize) -> Option<BodyChange>;
     /// Updates the contact after `change` (a no-op if it shares no body with it).
     fn update(&mut self, contact: u32, change: &BodyChange);
+    /// Whether the shock sweep may resolve the contact ([`super::shock`]).
+    fn sweeps_held(&self, _contact: u32) -> bool {
+        true
+    }
+    /// The contacts the pass resolves.
+    fn contacts(&self) -> &[PreparedContact];
+    /// The bodies the pass moves.
+    fn bodies(&self) -> &[SolverBody];
 }
 
 /// Per-contact marks so a contact adjacent to both changed bodies is updated once per pick.
@@ -110,7 +123,7 @@ impl PickScratch {
 /// Calls `f` once for every contact that shares a body with `change`, in the adjacency's
 /// order (a contact on both changed bodies once).
 #[inline]
-fn for_each_neighbour(
+pub(crate) fn for_each_neighbour(
     islands: &Islands,
     stamps: &mut Stamps,
     change: &BodyChange,
