@@ -196,21 +196,15 @@ fn without_the_direct_solve_a_light_column_under_a_heavy_box_falls() {
 
 #[test]
 fn the_millington_resolver_holds_heavy_boxes_on_light_ones() {
-    // Its shock sweep (`MillingtonSettings::shock_sweep`): 0.06-2.2 mm of drift and at most
-    // 0.13 mm of sink per layer. Not yet: a light column of five under a box 10,000 times
-    // heavier (484 mm of drift).
+    // Its shock sweep (`MillingtonSettings::shock_sweep`): 0.06-5.9 mm of drift and at most
+    // 0.3 mm of sink per layer (with four sweeps per level instead of eight, the 1:10,000
+    // column drifted 484 mm).
     let millington = Some(ResolverChoice::Millington(MillingtonSettings::default()));
-    for (ratio, n) in [
-        (10.0, 2),
-        (10.0, 5),
-        (100.0, 2),
-        (100.0, 5),
-        (1000.0, 2),
-        (1000.0, 5),
-        (10000.0, 2),
-    ] {
-        let case = family::heavy_on_light(ratio, n, Variant::default());
-        assert_stands_with(&case, 20.0, millington.clone());
+    for ratio in [10.0, 100.0, 1000.0, 10000.0] {
+        for n in [2, 5] {
+            let case = family::heavy_on_light(ratio, n, Variant::default());
+            assert_stands_with(&case, 20.0, millington.clone());
+        }
     }
 }
 

@@ -33,9 +33,12 @@ use super::prepare::PreparedContact;
 use super::worst_first::{Pass, PickScratch, for_each_neighbour};
 use crate::SolverBody;
 
-/// Sweeps over the contacts of one level before the next: the points of a face share their
-/// load through the upper body's rotation, which one sweep leaves partly unresolved.
-pub const SHOCK_SWEEPS: u32 = 4;
+/// Sweeps over the contacts of one level before the next, at most (a level ends when no
+/// contact of it is above the epsilon): the points of a face share their load through the
+/// upper body's rotation, which one sweep leaves partly unresolved. With four, a 1:1,000 pair
+/// stepped at `dt` 1.0 s left the heavy box rising at 8 mm/s, 8 mm of height and 77 J gained
+/// in a step; eight, sixteen and sixty-four sweeps give the same result there.
+pub const SHOCK_SWEEPS: u32 = 8;
 
 /// Mass ratio (dimensionless) between two movable bodies in contact from which their island
 /// is swept. Below it the worst-first picks pass a load on at a useful rate (about 1 − m/M
