@@ -41,11 +41,7 @@ fn a_3d_pyramid_of_10_layers_stands() {
 
 #[test]
 fn a_perturbed_3d_pyramid_of_10_layers_stands() {
-    let v = Variant {
-        seed: Some(1),
-        ..Variant::default()
-    };
-    assert_stands(&family::pyramid3d(10, v), 20.0);
+    assert_stands(&family::pyramid3d(10, family::seeded(1)), 20.0);
 }
 
 #[test]
@@ -115,11 +111,7 @@ fn columns_of_heights_sizes_and_frictions_the_family_does_not_hold_stand() {
 #[test]
 fn a_perturbed_column_of_20_stands() {
     // Without load compensation: 1.3 mm of sink per layer; at 4 substeps and 30 Hz it falls.
-    let v = Variant {
-        seed: Some(1),
-        ..Variant::default()
-    };
-    assert_stands(&family::column(20, v), 20.0);
+    assert_stands(&family::column(20, family::seeded(1)), 20.0);
 }
 
 #[test]
@@ -128,11 +120,7 @@ fn another_perturbed_column_of_20_stands() {
     // The landing leaves the top 13 mm out; it then sways about there, ±6 mm with a period of
     // about 3.3 s, decaying over a minute (point by point 13.9 mm; measured only at the end,
     // 4.9 mm).
-    let v = Variant {
-        seed: Some(2),
-        ..Variant::default()
-    };
-    assert_stands(&family::column(20, v), 20.0);
+    assert_stands(&family::column(20, family::seeded(2)), 20.0);
 }
 
 #[test]

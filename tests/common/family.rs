@@ -364,7 +364,7 @@ pub fn variations() -> Vec<Case> {
 }
 
 /// The default variant started perturbed from `seed`.
-fn seeded(seed: u64) -> Variant {
+pub fn seeded(seed: u64) -> Variant {
     Variant {
         seed: Some(seed),
         ..Variant::default()

@@ -103,8 +103,8 @@ use worst_first::{PickScratch, run_islands};
 /// resolver may), so swapping it in or out mid-simulation is safe.
 ///
 /// Warm starting is on by default: on resting stacks it makes the velocity pass converge
-/// within its budget (the 20-row pyramid: 53 ms → 0.8 ms per step, the 3D pyramid of 10:
-/// 223 → 3.5 ms, both drifting less). The shock sweep ([`shock`]) holds what the picks cannot:
+/// within its budget (the 20-row pyramid: 52.8 → 0.83 ms per step, the 3D pyramid of 10:
+/// 221 → 3.48 ms, both drifting less). The shock sweep ([`shock`]) holds what the picks cannot:
 /// a box under one 10 or more times heavier, which warm started alone was pushed through the
 /// floor at 1:10⁶ (benches/RESULTS.md, "The shock sweep, and the Millington resolver warm
 /// started by default").
@@ -265,6 +265,7 @@ impl MillingtonResolver {
             velocity_limit: settings.velocity_limit,
             velocity_epsilon: settings.velocity_epsilon,
             picked: u32::MAX,
+            picked_pair: [change::NO_BODY; 2],
         };
         stats.velocity_iterations = run_pass(
             &mut pass,
@@ -342,7 +343,9 @@ fn run_pass<P: worst_first::Pass>(
     );
     if settings.shock_sweep && scratch.residual > epsilon {
         shock.prepare(pass.contacts(), islands, pass.bodies());
-        picks += shock.sweep(pass, islands, scratch, epsilon);
+        if !shock.is_empty() {
+            picks += shock.sweep(pass, islands, scratch, epsilon);
+        }
     }
     picks
 }

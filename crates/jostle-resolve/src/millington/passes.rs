@@ -67,6 +67,9 @@ pub(crate) struct VelocityPass<'a> {
     pub(crate) velocity_epsilon: f32,
     /// The contact resolved by the last pick (its own update records its saturation).
     pub(crate) picked: u32,
+    /// Its two bodies, as the contact has them: the pair the last pick was made for, even
+    /// where it held one of them still ([`update_velocity_for`]).
+    pub(crate) picked_pair: [u32; 2],
 }
 
 impl Pass for VelocityPass<'_> {
@@ -87,6 +90,7 @@ impl Pass for VelocityPass<'_> {
 
     fn resolve(&mut self, contact: u32) -> Option<BodyChange> {
         self.picked = contact;
+        self.picked_pair = self.contacts[contact as usize].body;
         Some(resolve_velocity(
             &mut self.contacts[contact as usize],
             self.bodies,
@@ -114,6 +118,7 @@ impl Pass for VelocityPass<'_> {
             return None;
         }
         self.picked = contact;
+        self.picked_pair = p.body;
         p.take_resolved(&held);
         Some(change)
     }
@@ -130,14 +135,8 @@ impl Pass for VelocityPass<'_> {
     /// the change.
     #[inline]
     fn update(&mut self, contact: u32, change: &BodyChange) {
-        // The pair the change was made for: the picked contact's sides, even where the
-        // pick held one of them still.
-        let pair = self
-            .contacts
-            .get(self.picked as usize)
-            .map_or(change.body, |picked| picked.body);
         let p = &mut self.contacts[contact as usize];
-        if update_velocity_for(p, change, pair, self.velocity_limit) {
+        if update_velocity_for(p, change, self.picked_pair, self.velocity_limit) {
             reopen_friction(p, contact == self.picked, self.velocity_epsilon);
         }
     }

@@ -158,13 +158,9 @@ impl PreparedContact {
         held.body[side] = NO_BODY;
         let other = 1 - side;
         let n = held.normal();
-        (held.normal_inertia, held.linear_inertia) = match held.side_body(bodies, other) {
-            Some(b) => {
-                let along = b.inv_mass_along(n);
-                (along + angular_inertia(b, held.r[other], n), along)
-            }
-            None => (0.0, 0.0),
-        };
+        (held.normal_inertia, held.linear_inertia) = held
+            .side_body(bodies, other)
+            .map_or((0.0, 0.0), |b| side_inertias(b, held.r[other], n));
         held
     }
 
@@ -266,6 +262,14 @@ pub fn angular_inertia(body: &SolverBody, r: Vec3, n: Vec3) -> f32 {
     u.dot(body.inv_inertia * u)
 }
 
+/// One moving side's part of a contact's inertias along `n` at lever arm `r`:
+/// ([`PreparedContact::normal_inertia`], [`PreparedContact::linear_inertia`]).
+#[inline]
+fn side_inertias(body: &SolverBody, r: Vec3, n: Vec3) -> (f32, f32) {
+    let along = body.inv_mass_along(n);
+    (along + angular_inertia(body, r, n), along)
+}
+
 /// Prepares `contact` for the passes (seed lecture, "Desired Velocity Change"), or `None` when
 /// a body index is out of range (such a contact is ignored by the resolver).
 ///
@@ -318,9 +322,9 @@ pub fn prepare(
     let mut linear_inertia = 0.0;
     for (side, b) in [body_a, body_b].into_iter().enumerate() {
         if body[side] != NO_BODY {
-            let along = b.inv_mass_along(n);
-            linear_inertia += along;
-            normal_inertia += along + angular_inertia(b, r[side], n);
+            let (normal, linear) = side_inertias(b, r[side], n);
+            linear_inertia += linear;
+            normal_inertia += normal;
         }
     }
 

@@ -95,10 +95,19 @@ impl Shock {
                 }
             }
         }
+        self.order.clear();
+        if !self.swept.contains(&true) {
+            return;
+        }
         self.level.clear();
         self.level.resize(bodies.len(), u32::MAX);
         self.queue.clear();
-        for c in contacts.iter().filter(|c| c.normal_inertia > 0.0) {
+        // Levels only in the swept islands: each island's contacts touch its bodies alone.
+        for (c, _) in contacts
+            .iter()
+            .zip(&self.swept)
+            .filter(|&(c, &swept)| swept && c.normal_inertia > 0.0)
+        {
             let on_ground = match c.body {
                 [NO_BODY, b] | [b, NO_BODY] => b,
                 _ => continue,
@@ -126,7 +135,6 @@ impl Shock {
                 }
             }
         }
-        self.order.clear();
         for (i, c) in contacts.iter().enumerate() {
             if !(c.normal_inertia > 0.0 && self.swept[i]) {
                 continue;
@@ -146,6 +154,11 @@ impl Shock {
             self.order.push((entry.0, i as u32, entry.1));
         }
         self.order.sort_unstable();
+    }
+
+    /// Whether this step's sweep has nothing to resolve (no island holds a mass ratio).
+    pub(crate) fn is_empty(&self) -> bool {
+        self.order.is_empty()
     }
 
     /// Builds the levels and the order for this step's `contacts` over `bodies` bodies,
