@@ -33,6 +33,9 @@ fn soft(substeps: u32, contact_hertz: f32, static_hertz: f32) -> SoftStepSetting
         // The model's contacts are plain springs; load compensation stiffens a loaded spring
         // near its rest overlap, which the model does not describe.
         preload_rate: 0.0,
+        // Nor does it describe the direct solve, which sizes a column's springs by their load
+        // and solves the column exactly: Gauss-Seidel's soft step is what the model predicts.
+        direct_rows: 0,
         ..SoftStepSettings::default()
     }
 }

@@ -9,7 +9,8 @@
 //!    margin, or between two immovable bodies, take no part. The contacts are packed eight
 //!    manifolds to a batch of independent bodies ([`batch`]) and every kernel below works on
 //!    eight manifolds at once ([`lanes`]). Small islands where a heavy body rests on light
-//!    ones are picked out and their springs sized by their load ([`direct`]).
+//!    ones, and chains of bodies (columns), are picked out and their springs sized by their
+//!    load ([`direct`]).
 //! 2. per substep: integrate gravity into velocities;
 //!    warm start (apply the accumulated impulses: point by point in the first substep, then
 //!    as each body's sum carried from substep to substep, [`integrate::Carried`], except for
@@ -23,7 +24,8 @@
 //!    [`SoftStepSettings::block_relax`]). Friction is solved in the relax pass only, unless
 //!    [`SoftStepSettings::friction_in_bias_pass`] is set. After each pass the islands of
 //!    [`direct`] are solved exactly ([`direct::DirectIslands::correct`]), where Gauss-Seidel
-//!    would need about as many sweeps as their mass ratio. With [`PARALLEL_MIN_BATCHES`]
+//!    would need about as many sweeps as their mass ratio, or passes a column's load and lean
+//!    on one joint per sweep. With [`PARALLEL_MIN_BATCHES`]
 //!    batches or more the substeps may run on a team of threads, with the same result bit
 //!    for bit ([`team`]), whenever the team has measured faster than one thread
 //!    (`ThreadChoice`).
@@ -957,12 +959,18 @@ impl Resolver for SoftStepResolver {
         } else {
             self.settings.direct_rows
         };
+        // A chain is solved directly when its load and lean cannot go down it and back within
+        // the step's sweeps (one joint per sweep).
+        let sweeps = substeps.saturating_mul(1 + self.settings.relax_iterations);
         self.direct.build(
             &self.batches,
             &self.states,
             bodies,
-            direct_rows,
-            self.settings.direct_mass_ratio,
+            direct::Limits {
+                max_rows: direct_rows,
+                mass_ratio: self.settings.direct_mass_ratio,
+                min_chain: sweeps / 2 + 1,
+            },
         );
         self.direct
             .stiffen(&mut self.batches, ctx.gravity.length() * h);

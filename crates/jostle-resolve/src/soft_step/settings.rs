@@ -158,10 +158,14 @@ pub struct SoftStepSettings {
     /// Overlap (m) at which load compensation (`preload_rate`) holds a loaded contact.
     /// Default 0.0005.
     pub preload_target: f32,
-    /// Largest island (count of contact points) whose normal rows are solved directly when
-    /// its bodies' masses differ widely ([`super::direct`]). Default 64; 0 turns the direct
-    /// solve off; at most [`SoftStepSettings::MAX_DIRECT_ROWS`]. Its cost grows with the cube
-    /// of the count, twice per substep.
+    /// Largest island (count of contact points) whose rows are solved directly when its
+    /// bodies' masses differ widely ([`super::direct`]); a chain of bodies (each touching at
+    /// most two others, a column) longer than half the step's sweeps (`substeps` × (1 +
+    /// `relax_iterations`) / 2, 8 at the defaults) is solved directly up to
+    /// [`super::direct::CHAIN_ROWS`] times as many points. Default 64 (chains: 1,024 points,
+    /// 256 boxes); 0 turns the direct solve off; at most
+    /// [`SoftStepSettings::MAX_DIRECT_ROWS`]. The cost of a general island grows with the cube
+    /// of the count, a chain's linearly with its length.
     pub direct_rows: u32,
     /// Mass ratio (dimensionless, ≥ 1) between two movable bodies in contact from which their
     /// island is solved directly ([`super::direct`]) and its springs are sized by their load.
