@@ -177,8 +177,6 @@ impl Response {
                     inv_angular: [0.0; 3],
                 };
             }
-            let m = inv_inertia(body);
-            let cols = [wide(m.x_axis), wide(m.y_axis), wide(m.z_axis)];
             let (n, rn, w) = (wide(row.normal), wide(rn), wide(inv_mass));
             let linear = n.map(|x| sign * x);
             let angular = rn.map(|x| sign * x);
@@ -187,11 +185,7 @@ impl Response {
                 linear,
                 angular,
                 inv_linear: std::array::from_fn(|i| w[i] * linear[i]),
-                inv_angular: std::array::from_fn(|i| {
-                    (0..3)
-                        .map(|k| 0.5 * (cols[k][i] + cols[i][k]) * angular[k])
-                        .sum()
-                }),
+                inv_angular: symmetric_times(inv_inertia(body), angular),
             }
         };
         Self {
@@ -1419,13 +1413,8 @@ impl Solver {
                 .get(sum.body as usize)
                 .copied()
                 .unwrap_or(Mat3::ZERO);
-            let cols = [wide(m.x_axis), wide(m.y_axis), wide(m.z_axis)];
             let l: [f32; 3] = std::array::from_fn(|i| (sum.linear[i] * sum.inv_mass[i]) as f32);
-            let a: [f32; 3] = std::array::from_fn(|i| {
-                (0..3)
-                    .map(|k| 0.5 * (cols[k][i] + cols[i][k]) * sum.angular[k])
-                    .sum::<f64>() as f32
-            });
+            let a = symmetric_times(m, sum.angular).map(|x| x as f32);
             state.linear_velocity += Vec3::from_array(l);
             state.angular_velocity += Vec3::from_array(a);
         }
@@ -1442,6 +1431,17 @@ struct Island<'a> {
     /// The normal rows (within the island) by batch, then point.
     by_point: &'a [u32],
     inv_inertia: &'a [Mat3],
+}
+
+/// The symmetric part of `m` (an inverse inertia, symmetric but for rounding) times `v`, in
+/// f64.
+fn symmetric_times(m: Mat3, v: [f64; 3]) -> [f64; 3] {
+    let cols = [wide(m.x_axis), wide(m.y_axis), wide(m.z_axis)];
+    std::array::from_fn(|i| {
+        (0..3)
+            .map(|k| 0.5 * (cols[k][i] + cols[i][k]) * v[k])
+            .sum::<f64>()
+    })
 }
 
 /// A vector in f64.
