@@ -920,6 +920,11 @@ impl DirectIslands {
         self.queue.clear();
         self.rank.resize(self.degree.len(), NONE);
         let root = start_body.2;
+        // Every island holds a movable body (its rows are those of one); none: keep the order.
+        debug_assert!(root != u32::MAX, "an island without a movable body");
+        if root == u32::MAX {
+            return;
+        }
         self.rank[root as usize] = 0;
         self.queue.push(root);
         let mut head = 0;
