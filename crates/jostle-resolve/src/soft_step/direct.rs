@@ -25,8 +25,9 @@
 //!
 //! So for an island of at most [`super::SoftStepSettings::direct_rows`] contact points that
 //! holds a contact between two movable bodies whose masses differ by
-//! [`super::SoftStepSettings::direct_mass_ratio`] or more, and for a chain of two or more
-//! movable bodies of at most [`CHAIN_ROWS`] times as many points:
+//! [`super::SoftStepSettings::direct_mass_ratio`] or more, and for a chain whose load path is
+//! longer than half a step's sweeps ([`Limits::min_chain`]) of at most [`CHAIN_ROWS`] times as
+//! many points:
 //! 1. [`DirectIslands::stiffen`], once per step: each manifold's springs are sized by the
 //!    mass its load stands for, Λ/(|g|·h) for the per-substep impulse Λ its points start the
 //!    step with, where that exceeds their effective mass (the same ω and ζ, so a loaded
@@ -225,12 +226,13 @@ pub struct Limits {
     /// Mass ratio between two movable bodies in contact from which their island is solved
     /// directly ([`super::SoftStepSettings::direct_mass_ratio`]).
     pub mass_ratio: f32,
-    /// Fewest bodies of a chain solved directly: a chain whose load and lean Gauss-Seidel can
-    /// pass down and back up within a step's sweeps (one joint per sweep) is left to it. At
-    /// the defaults (8 substeps of one biased and one relax sweep) 9: piles of five boxes cost
-    /// what they did, and Gauss-Seidel holds perturbed columns of 8, where from 16 up they
-    /// swayed 1–16 cm (benches/RESULTS.md, "Each manifold's normal rows solved together, the
-    /// default").
+    /// Shortest load path of a chain solved directly, in bodies (its bodies that rest on
+    /// nothing immovable, plus one): a chain whose load and lean Gauss-Seidel can pass down
+    /// and back up within a step's sweeps (one joint per sweep) is left to it. At the
+    /// defaults (8 substeps of one biased and one relax sweep) 9: piles of five boxes and rows
+    /// of bodies side by side on the ground cost what they did, and Gauss-Seidel holds
+    /// perturbed columns of 8, where from 16 up they swayed 1–16 cm (benches/RESULTS.md,
+    /// "Each manifold's normal rows solved together, the default").
     pub min_chain: u32,
 }
 
@@ -360,6 +362,7 @@ pub struct DirectIslands {
     mixed: Vec<bool>,
     island_of: Vec<u32>,
     degree: Vec<u32>,
+    supported: Vec<bool>,
     chain: Vec<bool>,
     members: Vec<u32>,
     seen: Vec<bool>,
@@ -606,9 +609,9 @@ impl DirectIslands {
     /// between two movable bodies, kept when some manifold joins two movable bodies whose
     /// inverse masses differ by [`Limits::mass_ratio`] or more and they have at most
     /// [`Limits::max_rows`] contact points, or when they form a chain (every body touching at
-    /// most two others: a column) of at least [`Limits::min_chain`] bodies and at most
+    /// most two others: a column) whose load path is at least [`Limits::min_chain`] bodies and at most
     /// [`CHAIN_ROWS`] times `max_rows` points. Each island's rows are ordered
-    /// manifold by manifold outward from one end ([`DirectIslands::order_island`]), so that
+    /// manifold by manifold outward from one end (`DirectIslands::order_island`), so that
     /// its system is banded; `bodies` are the solver bodies `states` were loaded from (their
     /// world inverse inertia builds the couplings). Deterministic: islands in the batches'
     /// order.
@@ -648,14 +651,22 @@ impl DirectIslands {
         // the union-find (1.4% of a 20-row pyramid's step).
         self.degree.clear();
         self.degree.resize(states.len(), 0);
+        // And whether each rests on something immovable.
+        self.supported.clear();
+        self.supported.resize(states.len(), false);
         let mut any_mixed = false;
         for m in &batches.manifolds {
             for l in 0..LANES {
                 let (a, b) = (m.a[l], m.b[l]);
-                if movable(a) && movable(b) {
-                    self.degree[a as usize] += 1;
-                    self.degree[b as usize] += 1;
-                    any_mixed |= mixed(a, b);
+                match (movable(a), movable(b)) {
+                    (true, true) => {
+                        self.degree[a as usize] += 1;
+                        self.degree[b as usize] += 1;
+                        any_mixed |= mixed(a, b);
+                    }
+                    (true, false) => self.supported[a as usize] = true,
+                    (false, true) => self.supported[b as usize] = true,
+                    (false, false) => {}
                 }
             }
         }
@@ -681,8 +692,10 @@ impl DirectIslands {
         self.row_count.resize(states.len(), 0);
         self.mixed.clear();
         self.mixed.resize(states.len(), false);
-        // Per root: whether every member touches at most two others, and the members with
-        // another movable body counted (`seen` marks them).
+        // Per root: whether every member touches at most two others, and its members that
+        // rest on nothing immovable (`seen` marks those counted): a chain's load path is
+        // one longer (a column's bottom box rests on the ground; a row of boxes side by
+        // side on the ground has a load path of one box, which Gauss-Seidel settles).
         self.chain.clear();
         self.chain.resize(states.len(), true);
         self.members.clear();
@@ -708,7 +721,7 @@ impl DirectIslands {
                 for body in [m.a[l], m.b[l]] {
                     if movable(body) && !self.seen[body as usize] {
                         self.seen[body as usize] = true;
-                        if self.degree[body as usize] > 0 {
+                        if self.degree[body as usize] > 0 && !self.supported[body as usize] {
                             self.members[r] += 1;
                         }
                         if self.degree[body as usize] > 2 {
@@ -730,7 +743,7 @@ impl DirectIslands {
                 let r = root as usize;
                 let heavy = self.mixed[r] && self.row_count[r] <= max_rows;
                 let chain = self.chain[r]
-                    && self.members[r] >= min_chain.max(2)
+                    && self.members[r] + 1 >= min_chain.max(2)
                     && self.row_count[r] <= chain_rows;
                 if !heavy && !chain {
                     continue;
