@@ -308,6 +308,7 @@ fn json_summary(scene: &str, resolver: &str, dt: f32, bodies: usize, s: &RunSumm
             "position": s.picks_per_step[0],
             "velocity": s.picks_per_step[1],
         },
+        "direct_rows_per_step": s.direct_rows_per_step,
         "residual": {
             "position_median_m": s.residual_median[0],
             "position_max_m": s.residual_max[0],
@@ -355,6 +356,10 @@ fn print_table(scene: &str, resolver: &str, dt: f32, bodies: usize, s: &RunSumma
         (
             "picks per step, position / velocity".into(),
             format!("{:.1} / {:.1}", s.picks_per_step[0], s.picks_per_step[1]),
+        ),
+        (
+            "contact rows solved directly per step".into(),
+            format!("{:.1}", s.direct_rows_per_step),
         ),
         (
             "left unresolved, median / max: position (m)".into(),

@@ -100,6 +100,24 @@ fn json_is_one_object_on_stdout() {
 }
 
 #[test]
+fn json_reports_the_contact_rows_solved_directly() {
+    // A stack of 15 boxes is a chain the soft step solves directly; a single box is not.
+    let direct_rows = |file: &str| {
+        let out = jostle()
+            .args(["run", "--json", "--steps", "30"])
+            .arg(asset(file))
+            .output()
+            .unwrap();
+        assert_ok(&out);
+        let v: serde_json::Value =
+            serde_json::from_str(String::from_utf8(out.stdout).unwrap().trim()).unwrap();
+        v["direct_rows_per_step"].as_f64().unwrap()
+    };
+    assert!(direct_rows("stack_15.ron") > 0.0);
+    assert_eq!(direct_rows("box_drop.ron"), 0.0);
+}
+
+#[test]
 fn errors_exit_non_zero_with_the_message() {
     let bad = temp("bad.ron");
     std::fs::write(

@@ -88,6 +88,9 @@ pub struct RunSummary {
     pub residual_median: [f32; 2],
     /// See [`RunSummary::residual_median`].
     pub residual_max: [f32; 2],
+    /// Contact rows the soft step solved directly per step (the step profile's
+    /// `resolve_stats.direct_rows`), mean over the run.
+    pub direct_rows_per_step: f64,
 }
 
 impl RunSummary {
@@ -129,6 +132,7 @@ pub fn run(
     let dynamic = world.bodies().filter(|(_, _, b)| !b.is_fixed()).count();
     let mut residuals: [Vec<f32>; 2] = [Vec::with_capacity(reserve), Vec::with_capacity(reserve)];
     let mut picks = [0u64; 2];
+    let mut direct_rows = 0u64;
     for step in 1..=steps {
         let report = world.step(dt)?;
         s.quarantined
@@ -138,6 +142,7 @@ pub fn run(
         let r = &p.resolve_stats;
         picks[0] += u64::from(r.position_iterations);
         picks[1] += u64::from(r.velocity_iterations);
+        direct_rows += u64::from(r.direct_rows);
         residuals[0].push(r.position_residual);
         residuals[1].push(r.velocity_residual);
         for (i, (_, t)) in p.stages().iter().enumerate() {
@@ -153,6 +158,7 @@ pub fn run(
         observe(world, world.time().1).map_err(|e| RunError::Io(e.to_string()))?;
     }
     s.steps = steps;
+    s.direct_rows_per_step = direct_rows as f64 / steps.max(1) as f64;
     for pass in 0..2 {
         s.picks_per_step[pass] = picks[pass] as f64 / steps.max(1) as f64;
         let v = &mut residuals[pass];

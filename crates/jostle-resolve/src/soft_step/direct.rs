@@ -605,6 +605,11 @@ impl DirectIslands {
         self.islands.is_empty()
     }
 
+    /// The contact rows (normal and friction) solved directly this step.
+    pub fn rows(&self) -> usize {
+        self.rows.len()
+    }
+
     /// Finds this step's direct islands in the packed `batches`: bodies joined by manifolds
     /// between two movable bodies, kept when some manifold joins two movable bodies whose
     /// inverse masses differ by [`Limits::mass_ratio`] or more and they have at most

@@ -974,6 +974,7 @@ impl Resolver for SoftStepResolver {
         );
         self.direct
             .stiffen(&mut self.batches, ctx.gravity.length() * h);
+        stats.direct_rows = u32::try_from(self.direct.rows()).unwrap_or(u32::MAX);
         stats.prepare_time = start.elapsed();
 
         let push_out = self.settings.max_push_out;
