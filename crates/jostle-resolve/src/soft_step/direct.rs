@@ -364,7 +364,7 @@ pub struct DirectIslands {
     degree: Vec<u32>,
     supported: Vec<bool>,
     chain: Vec<bool>,
-    members: Vec<u32>,
+    unsupported: Vec<u32>,
     seen: Vec<bool>,
     first_row: Vec<u32>,
     manifold_runs: Vec<(u32, u32, u32, u32)>,
@@ -614,12 +614,11 @@ impl DirectIslands {
     /// between two movable bodies, kept when some manifold joins two movable bodies whose
     /// inverse masses differ by [`Limits::mass_ratio`] or more and they have at most
     /// [`Limits::max_rows`] contact points, or when they form a chain (every body touching at
-    /// most two others: a column) whose load path is at least [`Limits::min_chain`] bodies and at most
-    /// [`CHAIN_ROWS`] times `max_rows` points. Each island's rows are ordered
-    /// manifold by manifold outward from one end (`DirectIslands::order_island`), so that
-    /// its system is banded; `bodies` are the solver bodies `states` were loaded from (their
-    /// world inverse inertia builds the couplings). Deterministic: islands in the batches'
-    /// order.
+    /// most two others: a column) whose load path is at least [`Limits::min_chain`] bodies,
+    /// of at most [`CHAIN_ROWS`] times `max_rows` points. Each island's rows are ordered
+    /// manifold by manifold outward from one end (`DirectIslands::order_island`), so that its
+    /// system is banded; `bodies` are the solver bodies `states` were loaded from (their world
+    /// inverse inertia builds the couplings). Deterministic: islands in the batches' order.
     pub fn build(
         &mut self,
         batches: &Batches,
@@ -703,8 +702,8 @@ impl DirectIslands {
         // side on the ground has a load path of one box, which Gauss-Seidel settles).
         self.chain.clear();
         self.chain.resize(states.len(), true);
-        self.members.clear();
-        self.members.resize(states.len(), 0);
+        self.unsupported.clear();
+        self.unsupported.resize(states.len(), 0);
         self.seen.clear();
         self.seen.resize(states.len(), false);
         let root_of = |sets: &mut UnionFind, a: u32, b: u32| {
@@ -727,7 +726,7 @@ impl DirectIslands {
                     if movable(body) && !self.seen[body as usize] {
                         self.seen[body as usize] = true;
                         if self.degree[body as usize] > 0 && !self.supported[body as usize] {
-                            self.members[r] += 1;
+                            self.unsupported[r] += 1;
                         }
                         if self.degree[body as usize] > 2 {
                             self.chain[r] = false;
@@ -748,7 +747,7 @@ impl DirectIslands {
                 let r = root as usize;
                 let heavy = self.mixed[r] && self.row_count[r] <= max_rows;
                 let chain = self.chain[r]
-                    && self.members[r] + 1 >= min_chain.max(2)
+                    && self.unsupported[r] + 1 >= min_chain.max(2)
                     && self.row_count[r] <= chain_rows;
                 if !heavy && !chain {
                     continue;
