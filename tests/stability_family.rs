@@ -354,3 +354,51 @@ fn rigid_contacts_hold_a_column_of_20_small_boxes() {
     };
     assert_stands_with(&family::column(20, v), 20.0, rigid());
 }
+
+#[test]
+fn chains_are_solved_directly_from_a_load_path_of_nine() {
+    // At the defaults (8 substeps of a biased and a relax sweep) a chain whose load path (its
+    // bodies resting on nothing immovable, plus one) is 9 or more is solved directly: a column
+    // of 9 is, one of 8 is not, and neither is a row of 30 boxes side by side on the ground.
+    let direct_rows = |generator: &str| {
+        let ron = format!(
+            "Scene(sleep: (enabled: false), bodies: [Body(name: \"ground\", \
+             shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true)], generators: [{generator}])"
+        );
+        let scene = jostle::scene::Scene::parse(&ron, "chain").unwrap();
+        let mut world = scene.build_with(scene.settings()).unwrap();
+        let mut most = 0;
+        for _ in 0..30 {
+            world.step(1.0 / 60.0).unwrap();
+            most = most.max(world.profile().resolve_stats.direct_rows);
+        }
+        most
+    };
+    let column = |n| format!("Stack(count: {n}, half_extents: (0.5, 0.5, 0.5), friction: 0.5)");
+    assert!(direct_rows(&column(9)) > 0);
+    assert_eq!(direct_rows(&column(8)), 0);
+    let row = (0..30)
+        .map(|i| {
+            format!(
+                "Body(name: \"b{i}\", shape: Cuboid(half_extents: (0.5, 0.5, 0.5)), \
+                 position: ({}, 0.5, 0.0))",
+                i as f32 * 0.999
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    let ron = format!(
+        "Scene(sleep: (enabled: false), bodies: [Body(name: \"ground\", \
+         shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true), {row}])"
+    );
+    let scene = jostle::scene::Scene::parse(&ron, "row").unwrap();
+    let mut world = scene.build_with(scene.settings()).unwrap();
+    for _ in 0..30 {
+        world.step(1.0 / 60.0).unwrap();
+        assert_eq!(world.profile().resolve_stats.direct_rows, 0);
+    }
+    assert!(
+        world.contacts().len() > 4 * 30,
+        "the boxes touch their neighbours as well as the ground"
+    );
+}
