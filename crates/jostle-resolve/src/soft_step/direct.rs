@@ -46,7 +46,7 @@
 //!    pull are fixed at no impulse, friction that would leave its cone is fixed on it, and
 //!    the rest is solved again. J·M⁻¹·Jᵀ is built in f64 from the rows and the bodies'
 //!    inverse inertia (built in f32 it lost the heavy body of a 1:10⁶ pair in rounding and
-//!    was not positive semi-definite: `Row::coupling`), and a solution is summed per body in
+//!    was not positive semi-definite: `Response::coupling`), and a solution is summed per body in
 //!    f64 and applied through the same inverse inertia (`Solver::apply`). The system is
 //!    factorised by Cholesky in f64 over its profile (rows that depend on others get no
 //!    impulse of their own; `profile_factor`), with the rows ordered outward from one end
@@ -139,15 +139,15 @@ struct Row {
     /// r_A × d and r_B × d.
     rn_a: Vec3,
     rn_b: Vec3,
-    /// A friction row's least compliance ([`FRICTION_REGULARISATION`]); set once the
+    /// A friction row's least compliance (`Response::friction_floor`); set once the
     /// inverse inertia is known.
     floor: f64,
 }
 
-/// A row's Jacobian and M⁻¹·Jᵀ on each of its two bodies, in f64: the couplings
-/// ([`Row::coupling`]) as dot products, with the inverse inertia applied once per row
-/// instead of once per pair of rows (building a column's couplings was a fifth of its direct
-/// solve).
+/// A row's Jacobian and M⁻¹·Jᵀ on each of its two bodies, in f64, so that the couplings
+/// (`Response::coupling`) are dot products, with the inverse inertia applied once per row
+/// instead of once per pair of rows (building a column's couplings that way was a fifth of
+/// its direct solve).
 #[derive(Clone, Copy, Debug)]
 struct Response {
     sides: [Side; 2],
@@ -197,7 +197,13 @@ impl Response {
         }
     }
 
-    /// (J·M⁻¹·Jᵀ)ᵢⱼ: the change of this row's velocity per unit impulse on `other`.
+    /// (J·M⁻¹·Jᵀ)ᵢⱼ: the change of this row's velocity per unit impulse on `other`, in f64
+    /// from each shared body's inverse mass and world inverse inertia, so that the island's
+    /// matrix is a Gram matrix, positive semi-definite to f64's rounding (only its lower
+    /// triangle is built). Built in f32 from the rows' angular responses I⁻¹·(r × n), whose
+    /// rounding makes it neither, a 1 kg box under a 10⁶ kg one gave the matrix an eigenvalue
+    /// of −1.0·10⁻⁷ beside the heavy box's own, about 10⁻⁶: its contributions are the size of
+    /// the f32 rounding of the light box's.
     fn coupling(&self, other: &Response) -> f64 {
         let dot = |u: &[f64; 3], v: &[f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
         let mut sum = 0.0;
@@ -213,6 +219,24 @@ impl Response {
             }
         }
         sum
+    }
+
+    /// A friction row's least compliance: [`FRICTION_REGULARISATION`] times the smaller of
+    /// its two bodies' parts of its diagonal of J·M⁻¹·Jᵀ (a fixed body has none), the heavier
+    /// body's where the masses differ, so that its motion still converges at that rate.
+    fn friction_floor(&self) -> f64 {
+        let dot = |u: &[f64; 3], v: &[f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+        let smaller = self
+            .sides
+            .iter()
+            .filter(|side| side.body != STATIC_BODY)
+            .map(|side| dot(&side.linear, &side.inv_linear) + dot(&side.angular, &side.inv_angular))
+            .fold(f64::INFINITY, f64::min);
+        if smaller.is_finite() {
+            f64::from(FRICTION_REGULARISATION) * smaller
+        } else {
+            0.0
+        }
     }
 }
 
@@ -242,85 +266,6 @@ const NORMAL: u8 = 0;
 const TANGENT_1: u8 = 1;
 /// A point's friction row along its second tangent.
 const TANGENT_2: u8 = 2;
-
-impl Row {
-    /// [`FRICTION_REGULARISATION`] times the smaller of the two bodies' parts of the row's
-    /// diagonal of J·M⁻¹·Jᵀ (a fixed body has none): the heavier body's, where the masses
-    /// differ, so that its motion still converges at that rate.
-    fn friction_floor(&self, inv_inertia: &impl Fn(u32) -> Mat3) -> f64 {
-        let part = |one: Row| one.coupling(&one, inv_inertia);
-        let sides = [
-            (self.a != STATIC_BODY).then(|| {
-                part(Row {
-                    b: STATIC_BODY,
-                    ..*self
-                })
-            }),
-            (self.b != STATIC_BODY).then(|| {
-                part(Row {
-                    a: STATIC_BODY,
-                    ..*self
-                })
-            }),
-        ];
-        let smaller = sides.into_iter().flatten().fold(f64::INFINITY, f64::min);
-        if smaller.is_finite() {
-            f64::from(FRICTION_REGULARISATION) * smaller
-        } else {
-            0.0
-        }
-    }
-
-    /// The change of this row's normal velocity per unit impulse on `other`: (J·M⁻¹·Jᵀ)ᵢⱼ,
-    /// in f64 from each shared body's inverse mass and world inverse inertia
-    /// (`inv_inertia`), so that the island's matrix is a Gram matrix, symmetric and positive
-    /// semi-definite to f64's rounding. Built in f32 from the rows' angular responses
-    /// I⁻¹·(r × n), whose rounding makes it neither, a 1 kg box under a 10⁶ kg one gave the
-    /// matrix an eigenvalue of −1.0·10⁻⁷ beside the heavy box's own, about 10⁻⁶: its
-    /// contributions are the size of the f32 rounding of the light box's.
-    fn coupling(&self, other: &Row, inv_inertia: &impl Fn(u32) -> Mat3) -> f64 {
-        let mine = [(self.a, 1.0, self.rn_a), (self.b, -1.0, self.rn_b)];
-        let theirs = [
-            (other.a, 1.0, other.rn_a, other.inv_mass_a),
-            (other.b, -1.0, other.rn_b, other.inv_mass_b),
-        ];
-        let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
-        let mut sum = 0.0f64;
-        for (body, sign, rn) in mine {
-            if body == STATIC_BODY {
-                continue;
-            }
-            for &(other_body, other_sign, other_rn, inv_mass) in &theirs {
-                if other_body != body {
-                    continue;
-                }
-                let m = inv_inertia(body);
-                let cols = [wide(m.x_axis), wide(m.y_axis), wide(m.z_axis)];
-                // I⁻¹ symmetric: (I⁻¹)ᵢⱼ as the mean of its two stored entries.
-                let entry = |i: usize, j: usize| 0.5 * (cols[j][i] + cols[i][j]);
-                let (u, v) = (wide(rn), wide(other_rn));
-                // uᵀ·I⁻¹·v summed so that swapping u and v changes no bit.
-                let cross = |i: usize, j: usize| entry(i, j) * (u[i] * v[j] + u[j] * v[i]);
-                let angular = entry(0, 0) * (u[0] * v[0])
-                    + entry(1, 1) * (u[1] * v[1])
-                    + entry(2, 2) * (u[2] * v[2])
-                    + cross(0, 1)
-                    + cross(0, 2)
-                    + cross(1, 2);
-                let (n, m) = (wide(self.normal), wide(other.normal));
-                let linear = if inv_mass.x == inv_mass.y && inv_mass.y == inv_mass.z {
-                    f64::from(inv_mass.x) * dot(n, m)
-                } else {
-                    // A translation lock: M⁻¹ diagonal.
-                    let w = wide(inv_mass);
-                    w[0] * n[0] * m[0] + w[1] * n[1] * m[1] + w[2] * n[2] * m[2]
-                };
-                sum += sign * other_sign * (linear + angular);
-            }
-        }
-        sum
-    }
-}
 
 /// The islands of one step that are solved directly, and the scratch to solve them.
 #[derive(Clone, Debug, Default)]
@@ -372,7 +317,7 @@ pub struct DirectIslands {
     queue: Vec<u32>,
     rank: Vec<u32>,
     scratch_rows: Vec<Row>,
-    /// Each row's Jacobian and M⁻¹·Jᵀ, in f64 (`Response`), as the couplings are built.
+    /// Each row's Jacobian and M⁻¹·Jᵀ, in f64 (`Response`), as `rows` are.
     responses: Vec<Response>,
     /// The world inverse inertia of each body with rows in an island (by body index; zero
     /// elsewhere), as the rows' angular responses were prepared.
@@ -824,14 +769,16 @@ impl DirectIslands {
                 }
             }
         }
-        for row in &mut self.rows {
+        self.responses.clear();
+        self.responses
+            .extend(self.rows.iter().map(|row| Response::of(row, &inv_inertia)));
+        for (row, response) in self.rows.iter_mut().zip(&self.responses) {
             if row.kind != NORMAL {
-                row.floor = row.friction_floor(&inv_inertia);
+                row.floor = response.friction_floor();
             }
         }
         // Each island's J·M⁻¹·Jᵀ by its profile: row i from the first row that shares a
         // movable body with it (`first_row` of each body), to its diagonal.
-        self.responses.clear();
         self.first_row.clear();
         self.first_row.resize(states.len(), NONE);
         for &(start, end) in &self.islands {
@@ -850,11 +797,9 @@ impl DirectIslands {
                 }
                 self.first.push(first);
                 self.start.push(self.couplings.len() - base);
-                let mine = Response::of(row, &inv_inertia);
-                self.responses.push(mine);
-                let theirs = &self.responses[self.responses.len() - 1 - (i - first as usize)..];
-                for other in theirs {
-                    self.couplings.push(mine.coupling(other));
+                let responses = &self.responses[start as usize..end as usize];
+                for other in &responses[first as usize..=i] {
+                    self.couplings.push(responses[i].coupling(other));
                 }
             }
             for row in rows {
@@ -1183,13 +1128,6 @@ impl Solver {
         self.index.clear();
         self.index
             .extend((0..all).filter(|&i| self.role[i] == Role::Free));
-        self.on_face.clear();
-        self.on_face.resize(all, false);
-        for face in faces {
-            for &r in &face.rows[..face.count as usize] {
-                self.on_face[r as usize] = true;
-            }
-        }
         let n = self.index.len();
         if n == 0 {
             return self.role.contains(&Role::Fixed);
@@ -1236,6 +1174,13 @@ impl Solver {
     /// Factorises the system over the free rows `self.index` into `factor`, with each row's
     /// compliance (a face's in its saddle only, [`FaceModes`]). False when it fails.
     fn refactor(&mut self, couplings: Profile, faces: &[FaceModes], factor: &mut Factor) -> bool {
+        self.on_face.clear();
+        self.on_face.resize(self.role.len(), false);
+        for face in faces {
+            for &r in &face.rows[..face.count as usize] {
+                self.on_face[r as usize] = true;
+            }
+        }
         factor.index.clone_from(&self.index);
         factor.first.clear();
         factor.start.clear();
@@ -1787,8 +1732,8 @@ mod tests {
     fn couplings_are_the_gram_matrix_of_the_rows_in_f64() {
         // A light box between the ground and a 10⁶ times heavier box, turned so that no arm
         // or inertia entry is exact in f32: the couplings must be J·M⁻¹·Jᵀ computed in f64
-        // from the rows' f32 data, symmetric to the last bit (the heavy box's part, 10⁻⁶ of the
-        // light box's, is lost in f32 rounding otherwise).
+        // from the rows' f32 data (the heavy box's part, 10⁻⁶ of the light box's, is lost in
+        // f32 rounding otherwise), symmetric to f64's rounding.
         let turn =
             jostle_math::Quat::from_rotation_y(0.3) * jostle_math::Quat::from_rotation_x(0.01);
         let inertia = |scale: f32| {
@@ -1871,17 +1816,17 @@ mod tests {
             for rj in &rows {
                 let (ji, jj) = (jacobian(ri), apply_inverse_mass(jacobian(rj)));
                 let reference: f64 = ji.iter().zip(&jj).map(|(a, b)| a * b).sum();
-                let k = ri.coupling(rj, &inv_inertia);
-                assert_eq!(k.to_bits(), rj.coupling(ri, &inv_inertia).to_bits());
-                let fast = Response::of(ri, &inv_inertia).coupling(&Response::of(rj, &inv_inertia));
-                assert!(
-                    (fast - reference).abs() <= 1e-15 * (1.0 + reference.abs()),
-                    "{fast} {reference}"
+                let (a, b) = (
+                    Response::of(ri, &inv_inertia),
+                    Response::of(rj, &inv_inertia),
                 );
-                assert!(
-                    (k - reference).abs() <= 1e-15 * (1.0 + reference.abs()),
-                    "{k} {reference}"
-                );
+                let k = a.coupling(&b);
+                for value in [k, b.coupling(&a)] {
+                    assert!(
+                        (value - reference).abs() <= 1e-15 * (1.0 + reference.abs()),
+                        "{value} {reference}"
+                    );
+                }
             }
         }
     }
@@ -1926,7 +1871,9 @@ mod tests {
         let start: Vec<usize> = (0..4).map(|i| i * (i + 1) / 2).collect();
         let values: Vec<f64> = (0..4)
             .flat_map(|i| (0..=i).map(move |j| (i, j)))
-            .map(|(i, j)| rows[i].coupling(&rows[j], &inv_inertia))
+            .map(|(i, j)| {
+                Response::of(&rows[i], &inv_inertia).coupling(&Response::of(&rows[j], &inv_inertia))
+            })
             .collect();
         let profile = Profile {
             first: &first,
