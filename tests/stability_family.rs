@@ -126,7 +126,7 @@ fn another_perturbed_column_of_20_stands() {
 fn perturbed_tall_columns_stand() {
     // The tall set's perturbed columns of 40 and 60 boxes swayed 28–365 mm while Gauss-Seidel
     // solved them; solved directly as chains, with springs sized by their load and faces rigid
-    // in the relax pass, 0.3–5.7 mm (benches/RESULTS.md, "Chains of bodies solved directly").
+    // in the relax pass, 0.26–4.74 mm (benches/RESULTS.md, "Chains of bodies solved directly").
     let mixed = Variant {
         half: 1.0,
         friction: 0.4,
