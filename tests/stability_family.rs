@@ -356,10 +356,13 @@ fn rigid_contacts_hold_a_column_of_20_small_boxes() {
 }
 
 #[test]
-fn chains_are_solved_directly_from_a_load_path_of_nine() {
-    // At the defaults (8 substeps of a biased and a relax sweep) a chain whose load path (its
-    // bodies resting on nothing immovable, plus one) is 9 or more is solved directly: a column
-    // of 9 is, one of 8 is not, and neither is a row of 30 boxes side by side on the ground.
+fn chains_are_solved_directly_from_a_load_path_of_sixteen_within_a_budget() {
+    // At the defaults (8 substeps of a biased and a relax sweep: 16 sweeps) a chain whose load
+    // path (its bodies resting on nothing immovable, plus one) is 16 or more is solved
+    // directly: a column of 16 is, one of 15 is not, and neither is a row of 30 boxes side
+    // by side on the ground. Together the chains solved directly hold at most
+    // `direct_rows` × `CHAIN_ROWS` = 1,024 contact points: of 25 columns of 16 (64 points
+    // each) 16 are, the longest first.
     let direct_rows = |generator: &str| {
         let ron = format!(
             "Scene(sleep: (enabled: false), bodies: [Body(name: \"ground\", \
@@ -375,8 +378,11 @@ fn chains_are_solved_directly_from_a_load_path_of_nine() {
         most
     };
     let column = |n| format!("Stack(count: {n}, half_extents: (0.5, 0.5, 0.5), friction: 0.5)");
-    assert!(direct_rows(&column(9)) > 0);
-    assert_eq!(direct_rows(&column(8)), 0);
+    // A column of 16 boxes: 16 manifolds of 4 points, each a normal and two friction rows.
+    assert_eq!(direct_rows(&column(16)), 16 * 4 * 3);
+    assert_eq!(direct_rows(&column(15)), 0);
+    let piles = "Piles(nx: 5, nz: 5, height: 16, spacing: 1.5, friction: 0.5)";
+    assert_eq!(direct_rows(piles), 16 * (16 * 4 * 3));
     let row = (0..30)
         .map(|i| {
             format!(

@@ -26,8 +26,8 @@
 //! So for an island of at most [`super::SoftStepSettings::direct_rows`] contact points that
 //! holds a contact between two movable bodies whose masses differ by
 //! [`super::SoftStepSettings::direct_mass_ratio`] or more, and for a chain whose load path is
-//! longer than half a step's sweeps ([`Limits::min_chain`]) of at most [`CHAIN_ROWS`] times as
-//! many points:
+//! at least a step's sweeps ([`Limits::min_chain`]), the longest chains first while they hold
+//! at most [`CHAIN_ROWS`] times as many points together:
 //! 1. [`DirectIslands::stiffen`], once per step: each manifold's springs are sized by the
 //!    mass its load stands for, Λ/(|g|·h) for the per-substep impulse Λ its points start the
 //!    step with, where that exceeds their effective mass (the same ω and ζ, so a loaded
@@ -109,9 +109,11 @@ const FRICTION_REGULARISATION: f32 = 0.1;
 /// alone.
 const ACTIVE_SET_ROUNDS: usize = 8;
 
-/// How many times [`super::SoftStepSettings::direct_rows`] contact points a chain of bodies
-/// (a column) may have and still be solved directly: its cost grows linearly with its length
-/// (`profile_factor`), where a general island's grows with the cube of its size.
+/// How many times [`super::SoftStepSettings::direct_rows`] contact points the chains of bodies
+/// (columns) solved directly in one step may hold together: a chain's cost grows linearly with
+/// its length (`profile_factor`), where a general island's grows with the cube of its size,
+/// but it is ten to twenty times what Gauss-Seidel costs the same chain, so the budget bounds
+/// what a scene of many columns pays.
 pub const CHAIN_ROWS: u32 = 16;
 
 /// Relative slack of the friction cone in [`Solver::fix_sliding_points`]: a point is sliding
@@ -251,12 +253,12 @@ pub struct Limits {
     /// directly ([`super::SoftStepSettings::direct_mass_ratio`]).
     pub mass_ratio: f32,
     /// Shortest load path of a chain solved directly, in bodies (its bodies that rest on
-    /// nothing immovable, plus one): a chain whose load and lean Gauss-Seidel can pass down
-    /// and back up within a step's sweeps (one joint per sweep) is left to it. At the
-    /// defaults (8 substeps of one biased and one relax sweep) 9: piles of five boxes and rows
-    /// of bodies side by side on the ground cost what they did, and Gauss-Seidel holds
-    /// perturbed columns of 8, where from 16 up they swayed 1–16 cm (benches/RESULTS.md,
-    /// "Each manifold's normal rows solved together, the default").
+    /// nothing immovable, plus one): a chain whose load Gauss-Seidel can pass down within a
+    /// step's sweeps (one joint per sweep) is left to it. At the defaults (8 substeps of one
+    /// biased and one relax sweep) 16: Gauss-Seidel holds perturbed columns of up to 14 boxes
+    /// of 0.1 and 1 m within 1 cm, where at 16 they sway 1.0–1.6 cm; columns of 10 to 14 boxes
+    /// of 10 m sway 1.5–8 cm with it, and are the price of the budget's room for taller
+    /// columns (benches/RESULTS.md, "Chains solved directly within a budget").
     pub min_chain: u32,
 }
 
@@ -310,6 +312,8 @@ pub struct DirectIslands {
     supported: Vec<bool>,
     chain: Vec<bool>,
     unsupported: Vec<u32>,
+    /// The chains that may be solved directly, as (load path less one, root).
+    chain_roots: Vec<(u32, u32)>,
     seen: Vec<bool>,
     first_row: Vec<u32>,
     manifold_runs: Vec<(u32, u32, u32, u32)>,
@@ -680,7 +684,36 @@ impl DirectIslands {
                 }
             }
         }
+        // The chains solved directly: those with a load path of at least `min_chain`, the
+        // longest first (then by root), while their points together stay within the budget
+        // of `CHAIN_ROWS` times `max_rows`; the others stay with Gauss-Seidel. A chain costs
+        // ten to twenty times what Gauss-Seidel costs it, so the budget bounds what a scene
+        // of many columns pays: 4,000 boxes landing as 400 columns of ten took 140 ms a step
+        // with every column solved directly, 5.6 ms with none (benches/RESULTS.md, "Chains
+        // solved directly within a budget").
         let chain_rows = max_rows.saturating_mul(CHAIN_ROWS);
+        self.chain_roots.clear();
+        for b in 0..states.len() as u32 {
+            let r = b as usize;
+            if self.row_count[r] == 0 || self.sets.find(b) != b {
+                continue;
+            }
+            let heavy = self.mixed[r] && self.row_count[r] <= max_rows;
+            if self.chain[r] && !heavy && self.unsupported[r] + 1 >= min_chain.max(2) {
+                self.chain_roots.push((self.unsupported[r], b));
+            }
+            self.chain[r] = false;
+        }
+        self.chain_roots
+            .sort_unstable_by_key(|&(path, root)| (std::cmp::Reverse(path), root));
+        let mut budget = chain_rows;
+        for &(_, root) in &self.chain_roots {
+            let rows = self.row_count[root as usize];
+            if rows <= budget {
+                budget -= rows;
+                self.chain[root as usize] = true;
+            }
+        }
         self.island_of.clear();
         self.island_of.resize(states.len(), NONE);
         let mut islands = 0u32;
@@ -691,9 +724,7 @@ impl DirectIslands {
                 };
                 let r = root as usize;
                 let heavy = self.mixed[r] && self.row_count[r] <= max_rows;
-                let chain = self.chain[r]
-                    && self.unsupported[r] + 1 >= min_chain.max(2)
-                    && self.row_count[r] <= chain_rows;
+                let chain = self.chain[r];
                 if !heavy && !chain {
                     continue;
                 }

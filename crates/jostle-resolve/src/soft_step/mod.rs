@@ -959,8 +959,8 @@ impl Resolver for SoftStepResolver {
         } else {
             self.settings.direct_rows
         };
-        // A chain is solved directly when its load and lean cannot go down it and back within
-        // the step's sweeps (one joint per sweep).
+        // A chain is solved directly when its load cannot go down it within the step's
+        // sweeps (one joint per sweep).
         let sweeps = substeps.saturating_mul(1 + self.settings.relax_iterations);
         self.direct.build(
             &self.batches,
@@ -969,7 +969,7 @@ impl Resolver for SoftStepResolver {
             direct::Limits {
                 max_rows: direct_rows,
                 mass_ratio: self.settings.direct_mass_ratio,
-                min_chain: sweeps / 2 + 1,
+                min_chain: sweeps,
             },
         );
         self.direct

@@ -161,10 +161,10 @@ pub struct SoftStepSettings {
     /// Largest island (count of contact points) whose rows are solved directly when its
     /// bodies' masses differ widely ([`super::direct`]); a chain of bodies (each touching at
     /// most two others, a column) whose load path (its bodies resting on nothing immovable,
-    /// plus one) is longer than half the step's sweeps (`substeps` × (1 + `relax_iterations`)
-    /// / 2, 8 at the defaults) is solved directly up to [`super::direct::CHAIN_ROWS`] times
-    /// as many points. Default 64 (chains: 1,024 points,
-    /// 256 boxes); 0 turns the direct solve off; at most
+    /// plus one) is at least the step's sweeps (`substeps` × (1 + `relax_iterations`), 16 at
+    /// the defaults) is solved directly, the longest chains first while together they hold
+    /// at most [`super::direct::CHAIN_ROWS`] times as many points. Default 64 (chains: 1,024
+    /// points, 256 unit boxes); 0 turns the direct solve off; at most
     /// [`SoftStepSettings::MAX_DIRECT_ROWS`]. The cost of a general island grows with the cube
     /// of the count, a chain's linearly with its length.
     pub direct_rows: u32,
