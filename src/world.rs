@@ -105,6 +105,12 @@ pub struct World {
     pub(crate) paths: bool,
     /// The user's pair filter ([`World::set_pair_filter`]); not kept in snapshots.
     pair_filter: Option<Box<PairFilter>>,
+    /// The last step was a rest step (no body awake or moving, no candidate pair, no body
+    /// woken, no path), and nothing has changed the world since: every `&mut self` method
+    /// but [`World::step`] and [`World::update_queries`] clears it. The next step would
+    /// change nothing but the clock (each stage finds nothing to do, as in the rest step
+    /// before it), so it only advances the clock ([`World::step`]).
+    settled: bool,
 }
 
 impl World {
@@ -127,6 +133,7 @@ impl World {
             query_stamp: 0,
             paths: false,
             pair_filter: None,
+            settled: false,
         }
     }
 
@@ -137,6 +144,7 @@ impl World {
 
     /// Replaces the resolver (any implementation of [`Resolver`]).
     pub fn set_resolver(&mut self, resolver: Box<dyn Resolver>) {
+        self.settled = false;
         self.resolver = resolver;
     }
 
@@ -149,6 +157,7 @@ impl World {
     /// whose centre of mass is not their origin (convex hulls, compounds), it differs from
     /// `desc.position` by the rotated centre-of-mass offset.
     pub fn add_body(&mut self, desc: BodyDesc) -> Result<BodyHandle, BodyError> {
+        self.settled = false;
         desc.validate()?;
         self.stamp += 1;
         let shape = desc.shape.build().map_err(|e| shape_error(&desc.name, e))?;
@@ -257,6 +266,7 @@ impl World {
     /// assert!(world.body(ball).is_none() && world.remove_body(ball).is_err());
     /// ```
     pub fn remove_body(&mut self, handle: BodyHandle) -> Result<RigidBody, StepError> {
+        self.settled = false;
         if !self.bodies.contains(handle) {
             return Err(StepError::InvalidHandle(handle));
         }
@@ -334,6 +344,7 @@ impl World {
         body: BodyHandle,
         desc: ColliderDesc,
     ) -> Result<ColliderHandle, StepError> {
+        self.settled = false;
         let b = self
             .bodies
             .get(body)
@@ -425,6 +436,7 @@ impl World {
     /// without colliders touches nothing). The body and what the collider touched wake, as for
     /// [`World::remove_body`].
     pub fn remove_collider(&mut self, handle: ColliderHandle) -> Result<Collider, StepError> {
+        self.settled = false;
         let body = self
             .colliders
             .get(handle)
@@ -512,6 +524,7 @@ impl World {
 
     /// Adds a force (N) through the centre of mass for the next step; wakes the body's island.
     pub fn apply_force(&mut self, handle: BodyHandle, force: Vec3) -> Result<(), StepError> {
+        self.settled = false;
         Self::finite("force", force)?;
         self.body_mut_awake(handle)?.add_force(force);
         Ok(())
@@ -524,6 +537,7 @@ impl World {
         force: Vec3,
         point: Vec3,
     ) -> Result<(), StepError> {
+        self.settled = false;
         Self::finite("force", force)?;
         Self::finite("point", point)?;
         self.body_mut_awake(handle)?
@@ -533,6 +547,7 @@ impl World {
 
     /// Adds a torque (N·m) for the next step; wakes the body's island.
     pub fn apply_torque(&mut self, handle: BodyHandle, torque: Vec3) -> Result<(), StepError> {
+        self.settled = false;
         Self::finite("torque", torque)?;
         self.body_mut_awake(handle)?.add_torque(torque);
         Ok(())
@@ -547,6 +562,7 @@ impl World {
         impulse: Vec3,
         point: Vec3,
     ) -> Result<(), StepError> {
+        self.settled = false;
         Self::finite("impulse", impulse)?;
         Self::finite("point", point)?;
         // Refused, changing nothing, when the velocities it would give are beyond the limits
@@ -580,6 +596,7 @@ impl World {
         position: Vec3,
         rotation: Quat,
     ) -> Result<(), StepError> {
+        self.settled = false;
         let unit = Self::checked_pose(position, rotation)?;
         let body = self.body_mut_awake(handle)?;
         body.position = position;
@@ -597,6 +614,7 @@ impl World {
         linear: Vec3,
         angular: Vec3,
     ) -> Result<(), StepError> {
+        self.settled = false;
         Self::finite("linear velocity", linear)?;
         Self::finite("angular velocity", angular)?;
         Self::within_speed_limits(linear, angular)?;
@@ -610,12 +628,14 @@ impl World {
 
     /// Wakes the body and its sleeping island.
     pub fn wake(&mut self, handle: BodyHandle) -> Result<(), StepError> {
+        self.settled = false;
         self.body_mut_awake(handle).map(|_| ())
     }
 
     /// Puts the body to sleep now (zero velocity); it wakes on contact with an awake body, a
     /// force, an impulse or a pose set, like any sleeping body.
     pub fn sleep(&mut self, handle: BodyHandle) -> Result<(), StepError> {
+        self.settled = false;
         let body = self
             .bodies
             .get_mut(handle)
@@ -634,6 +654,7 @@ impl World {
         handle: ColliderHandle,
         material: Material,
     ) -> Result<(), StepError> {
+        self.settled = false;
         check_material(&material).map_err(invalid)?;
         let body = self.change_collider(handle, |c| c.material = material)?;
         self.islands
@@ -665,6 +686,7 @@ impl World {
     /// assert!(entered);
     /// ```
     pub fn set_sensor(&mut self, handle: ColliderHandle, sensor: bool) -> Result<(), StepError> {
+        self.settled = false;
         let body = self.change_collider(handle, |c| c.sensor = sensor)?;
         self.wake_around(body);
         Ok(())
@@ -708,6 +730,7 @@ impl World {
     /// assert!(world.body(ghost).unwrap().position.y < -1.0, "it fell through the ground");
     /// ```
     pub fn set_pair_filter(&mut self, filter: Option<Box<PairFilter>>) {
+        self.settled = false;
         self.pair_filter = filter;
         self.wake_all();
     }
@@ -720,6 +743,7 @@ impl World {
         handle: ColliderHandle,
         threshold: Option<f32>,
     ) -> Result<(), StepError> {
+        self.settled = false;
         check_force_threshold(threshold).map_err(invalid)?;
         self.change_collider(handle, |c| c.force_event_threshold = threshold)?;
         Ok(())
@@ -732,6 +756,7 @@ impl World {
         handle: ColliderHandle,
         groups: CollisionGroups,
     ) -> Result<(), StepError> {
+        self.settled = false;
         let body = self.change_collider(handle, |c| c.groups = groups)?;
         self.wake_around(body);
         Ok(())
@@ -750,6 +775,7 @@ impl World {
     /// assert!(world.set_material(puck, Material::new(-1.0, 0.0)).is_err());
     /// ```
     pub fn set_material(&mut self, body: BodyHandle, material: Material) -> Result<(), StepError> {
+        self.settled = false;
         check_material(&material).map_err(invalid)?;
         if !self.bodies.contains(body) {
             return Err(StepError::InvalidHandle(body));
@@ -769,6 +795,7 @@ impl World {
         linear: f32,
         angular: f32,
     ) -> Result<(), StepError> {
+        self.settled = false;
         for (field, x) in [("linear_damping", linear), ("angular_damping", angular)] {
             if !(x.is_finite() && x >= 0.0) {
                 return Err(invalid((
@@ -792,6 +819,7 @@ impl World {
     /// Refused for a fixed body ([`World::set_fixed`] makes it dynamic) and for limits a scene
     /// file refuses; wakes the body.
     pub fn set_mass(&mut self, handle: BodyHandle, mass: MassSpec) -> Result<(), StepError> {
+        self.settled = false;
         let body = self
             .bodies
             .get(handle)
@@ -826,6 +854,7 @@ impl World {
     /// assert!(world.body(shelf).unwrap().position.y < 1.0);
     /// ```
     pub fn set_fixed(&mut self, handle: BodyHandle, fixed: bool) -> Result<(), StepError> {
+        self.settled = false;
         self.set_body_type(
             handle,
             if fixed {
@@ -865,6 +894,7 @@ impl World {
         handle: BodyHandle,
         body_type: BodyType,
     ) -> Result<(), StepError> {
+        self.settled = false;
         let body = self
             .bodies
             .get(handle)
@@ -946,6 +976,7 @@ impl World {
         handle: BodyHandle,
         path: Option<KinematicPath>,
     ) -> Result<(), StepError> {
+        self.settled = false;
         if let Some(path) = &path {
             path.check()
                 .map_err(|(field, message)| invalid((&format!("path.{field}"), message)))?;
@@ -977,6 +1008,7 @@ impl World {
         position: Vec3,
         rotation: Quat,
     ) -> Result<(), StepError> {
+        self.settled = false;
         let unit = Self::checked_pose(position, rotation)?;
         let body = self
             .bodies
@@ -999,6 +1031,7 @@ impl World {
     /// Scales the world's gravity on one body (finite: 0 floats, 1 is the default, −1 falls up);
     /// wakes it.
     pub fn set_gravity_scale(&mut self, handle: BodyHandle, scale: f32) -> Result<(), StepError> {
+        self.settled = false;
         if !(scale.is_finite() && (scale * self.settings.gravity.length()) <= MAX_GRAVITY) {
             return Err(invalid((
                 "gravity_scale",
@@ -1011,6 +1044,7 @@ impl World {
 
     /// Sets a body's continuous collision detection mode; wakes it.
     pub fn set_ccd(&mut self, handle: BodyHandle, mode: CcdMode) -> Result<(), StepError> {
+        self.settled = false;
         self.body_mut_awake(handle)?.ccd = mode;
         Ok(())
     }
@@ -1035,6 +1069,7 @@ impl World {
         handle: BodyHandle,
         locks: [bool; 3],
     ) -> Result<(), StepError> {
+        self.settled = false;
         self.unfixed_body_mut(handle, "rotation_locks", "a fixed body does not turn")?
             .set_rotation_locks(locks);
         Ok(())
@@ -1065,6 +1100,7 @@ impl World {
         handle: BodyHandle,
         locks: [bool; 3],
     ) -> Result<(), StepError> {
+        self.settled = false;
         self.unfixed_body_mut(handle, "translation_locks", "a fixed body does not move")?
             .set_translation_locks(locks);
         Ok(())
@@ -1091,6 +1127,7 @@ impl World {
 
     /// Allows or forbids a body to sleep; forbidding wakes it (and its island).
     pub fn set_can_sleep(&mut self, handle: BodyHandle, can_sleep: bool) -> Result<(), StepError> {
+        self.settled = false;
         let body = if can_sleep {
             self.bodies
                 .get_mut(handle)
@@ -1105,6 +1142,7 @@ impl World {
     /// Sets the world's gravity (m/s², finite, at most [`crate::MAX_GRAVITY`]); every
     /// sleeping body wakes, since what held it may no longer.
     pub fn set_gravity(&mut self, gravity: Vec3) -> Result<(), StepError> {
+        self.settled = false;
         if !(gravity.is_finite() && gravity.length() <= MAX_GRAVITY) {
             return Err(invalid((
                 "gravity",
@@ -1121,6 +1159,7 @@ impl World {
     /// [`World::set_resolver`], the choice is recorded in the settings, so snapshots carry it.
     /// Every body wakes.
     pub fn set_resolver_choice(&mut self, choice: ResolverChoice) -> Result<(), StepError> {
+        self.settled = false;
         choice
             .validate()
             .map_err(|(field, message)| StepError::Invalid {
@@ -1343,11 +1382,32 @@ impl World {
     ///    against resting geometry and, on a hit, moved back to the time of impact;
     /// 7. scatter — results back to the bodies, impulses back to the manifolds, quarantine;
     /// 8. sleep — motion averages, islands, resting islands go to sleep.
+    ///
+    /// A step after a rest step (nothing awake or moving, no candidate pair, nothing woken)
+    /// with no change to the world since (any `&mut self` method but this one and
+    /// [`World::update_queries`] counts as a change) would repeat it stage by stage: it only
+    /// advances the clock, reports no events and profiles no stage time.
     pub fn step(&mut self, dt: f32) -> Result<StepReport, StepError> {
         if !(dt.is_finite() && dt > 0.0 && dt <= crate::MAX_DT) {
             return Err(StepError::InvalidDt(dt));
         }
         let start = Stopwatch::start();
+        if self.settled && !self.paths {
+            // Nothing is awake or moving and nothing changed since the last step, which found
+            // nothing to do: this one would find the same. Only the clock moves on.
+            self.narrow.clear_events();
+            self.profile = StepProfile {
+                awake_bodies: self.profile.awake_bodies,
+                sleeping_bodies: self.profile.sleeping_bodies,
+                islands_count: self.profile.islands_count,
+                total: start.elapsed(),
+                ..StepProfile::default()
+            };
+            self.time += dt as f64;
+            self.steps += 1;
+            self.stamp += 1;
+            return Ok(StepReport::default());
+        }
         let mut p = StepProfile::default();
         let mut report = StepReport::default();
         if self.paths {
@@ -1432,6 +1492,16 @@ impl World {
         p.sleep = t.elapsed();
 
         p.contact_points = self.scratch.contacts.len();
+        // A rest step: no candidate pair, nothing woke, no body in the solve (the static
+        // entry only) and no kinematic target or quarantine; the next one, if nothing changes
+        // the world meanwhile, would repeat it.
+        self.settled = p.candidate_pairs == 0
+            && !woke
+            && self.scratch.bodies.len() <= 1
+            && self.scratch.kinematic_targets.is_empty()
+            && report.quarantined.is_empty()
+            && p.awake_bodies == 0
+            && !self.paths;
         p.total = start.elapsed();
         self.profile = p;
         self.time += dt as f64;

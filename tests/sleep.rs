@@ -253,3 +253,56 @@ fn pushed_apart_with(r: &ResolverChoice, radius: f32) {
         "{name}: asleep at step {asleep_at:?} with {deepest} m of overlap left (tolerance {tolerance} m)"
     );
 }
+
+#[test]
+fn a_world_at_rest_steps_as_a_full_step_would_and_wakes_on_any_change() {
+    // Once a step finds nothing awake and nothing to do, the next steps only move the clock
+    // until something changes the world. Against a twin whose every step is made to run in
+    // full (a call that changes nothing but marks the world changed): the same state, contacts
+    // and events at every step, before and after a push wakes a pile.
+    let text = "Scene(bodies: [Body(name: \"ground\", shape: HalfSpace(normal: (0.0, 1.0, 0.0)), \
+                fixed: true)], generators: [Piles(nx: 2, nz: 1, height: 3, spacing: 3.0)])";
+    let scene = Scene::parse(text, "piles").unwrap();
+    let mut resting = scene.build_with(scene.settings()).unwrap();
+    let mut full = scene.build_with(scene.settings()).unwrap();
+    let ground = full.colliders_of(full.find_body("ground").unwrap())[0];
+    let top = resting.find_body("pile-5").unwrap();
+    let mut skipped = 0;
+    for step in 0..900 {
+        if step == 600 {
+            let at = resting.body(top).unwrap().position + Vec3::new(0.0, 0.4, 0.0);
+            for w in [&mut resting, &mut full] {
+                w.apply_impulse_at_point(top, Vec3::new(2.0, 0.0, 0.0), at)
+                    .unwrap();
+            }
+        }
+        full.set_force_event_threshold(ground, None).unwrap();
+        resting.step(DT).unwrap();
+        full.step(DT).unwrap();
+        assert_eq!(resting.state_hash(), full.state_hash(), "step {step}");
+        assert_eq!(
+            resting.contacts().len(),
+            full.contacts().len(),
+            "step {step}"
+        );
+        assert_eq!(resting.events(), full.events(), "step {step}");
+        assert_eq!(resting.time(), full.time());
+        let p = resting.profile();
+        if p.broad_phase == std::time::Duration::ZERO {
+            skipped += 1;
+            assert_eq!(p.awake_bodies, 0);
+            assert_eq!(p.sleeping_bodies, 6);
+            assert!(full.profile().broad_phase > std::time::Duration::ZERO);
+        }
+        if step == 601 {
+            assert!(
+                resting.body(top).unwrap().sleep.awake,
+                "the push wakes the pile"
+            );
+        }
+    }
+    assert!(
+        skipped > 100,
+        "the piles sleep well before step 600, and again before 900: {skipped} steps skipped"
+    );
+}

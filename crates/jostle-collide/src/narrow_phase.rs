@@ -519,6 +519,14 @@ impl NarrowPhase {
         )
     }
 
+    /// Forgets the last update's events (collision, sensor and contact force events), keeping
+    /// every pair and contact: for a step in which nothing can change, which reports none.
+    pub fn clear_events(&mut self) {
+        self.events.clear();
+        self.sensor_events.clear();
+        self.force_events.clear();
+    }
+
     /// Puts events taken with [`NarrowPhase::take_events`] before the last update's, so that a
     /// second update in one step (after bodies woke) loses none of the first's.
     pub fn restore_events(
