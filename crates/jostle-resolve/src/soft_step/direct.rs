@@ -256,9 +256,10 @@ pub struct Limits {
     /// nothing immovable, plus one): a chain whose load Gauss-Seidel can pass down within a
     /// step's sweeps (one joint per sweep) is left to it. At the defaults (8 substeps of one
     /// biased and one relax sweep) 16: Gauss-Seidel holds perturbed columns of up to 14 boxes
-    /// of 0.1 and 1 m within 1 cm, where at 16 they sway 1.0–1.6 cm; columns of 10 to 14 boxes
-    /// of 10 m sway 1.5–8 cm with it, and are the price of the budget's room for taller
-    /// columns (benches/RESULTS.md, "Chains solved directly within a budget").
+    /// of 0.1 and 1 m within 1 cm, where at 16 they sway 1.0–1.6 cm. Columns of 10 to 14
+    /// boxes of 10 m sway 1.5–8 cm with it: the price of keeping piles and lattices of such
+    /// columns at Gauss-Seidel's cost (benches/RESULTS.md, "Chains solved directly within a
+    /// budget").
     pub min_chain: u32,
 }
 
@@ -688,9 +689,9 @@ impl DirectIslands {
         // longest first (then by root), while their points together stay within the budget
         // of `CHAIN_ROWS` times `max_rows`; the others stay with Gauss-Seidel. A chain costs
         // ten to twenty times what Gauss-Seidel costs it, so the budget bounds what a scene
-        // of many columns pays: 4,000 boxes landing as 400 columns of ten took 140 ms a step
-        // with every column solved directly, 5.6 ms with none (benches/RESULTS.md, "Chains
-        // solved directly within a budget").
+        // of many columns pays: 4,000 boxes landing as 400 columns of ten, each solved
+        // directly when chains started at a load path of nine, took 140 ms a step, 5.6 ms
+        // with none (benches/RESULTS.md, "Chains solved directly within a budget").
         let chain_rows = max_rows.saturating_mul(CHAIN_ROWS);
         self.chain_roots.clear();
         for b in 0..states.len() as u32 {
