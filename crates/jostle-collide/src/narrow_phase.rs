@@ -1469,41 +1469,49 @@ fn cross_check_depth(
     let Some(bound) = depth_bound(c1, c2, pos12) else {
         return;
     };
-    if depth <= bound + 1e-3 + 0.01 * bound.abs() {
+    let plausible = |depth: f32| depth <= bound + 1e-3 + 0.01 * bound.abs();
+    if plausible(depth) {
         return;
     }
+    // The shallower of a (non-empty) answer from no manifold and the one reported.
+    let shallower = |answer: Option<(Vec<Manifold>, _)>, depth: f32| {
+        answer.filter(|(m, _)| !m.is_empty() && max_penetration(m) < depth)
+    };
     let mut depth = depth;
-    let mut fresh: Vec<Manifold> = Vec::new();
-    let mut workspace = None;
-    let result = DefaultQueryDispatcher.contact_manifolds(
-        pos12,
-        &*c1.shape.0,
-        &*c2.shape.0,
-        prediction,
-        &mut fresh,
-        &mut workspace,
-    );
-    if result.is_ok() && !fresh.is_empty() && max_penetration(&fresh) < depth {
+    if let Some((fresh, workspace)) = shallower(afresh(pos12, c1, c2, prediction), depth) {
         depth = max_penetration(&fresh);
         state.manifolds = fresh;
         state.workspace = workspace;
-        if depth <= bound + 1e-3 + 0.01 * bound.abs() {
+        if plausible(depth) {
             return;
         }
     }
-    let mut flipped: Vec<Manifold> = Vec::new();
-    let mut workspace = None;
-    let result = DefaultQueryDispatcher.contact_manifolds(
-        &pos12.inverse(),
-        &*c2.shape.0,
-        &*c1.shape.0,
-        prediction,
-        &mut flipped,
-        &mut workspace,
-    );
-    if result.is_ok() && !flipped.is_empty() && max_penetration(&flipped) < depth {
+    if let Some((flipped, _)) = shallower(afresh(&pos12.inverse(), c2, c1, prediction), depth) {
         state.manifolds = flipped.into_iter().map(swap_shapes).collect();
     }
+}
+
+/// The manifolds of `c1` and `c2` at `pos12` (`c2`'s pose in `c1`'s frame) computed from none,
+/// with their workspace; `None` for an unsupported pair.
+fn afresh(
+    pos12: &Pose,
+    c1: &Collider,
+    c2: &Collider,
+    prediction: f32,
+) -> Option<(Vec<Manifold>, Option<ContactManifoldsWorkspace>)> {
+    let mut manifolds = Vec::new();
+    let mut workspace = None;
+    DefaultQueryDispatcher
+        .contact_manifolds(
+            pos12,
+            &*c1.shape.0,
+            &*c2.shape.0,
+            prediction,
+            &mut manifolds,
+            &mut workspace,
+        )
+        .ok()?;
+    Some((manifolds, workspace))
 }
 
 /// The same manifold seen with its two shapes exchanged.
