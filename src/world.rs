@@ -1392,7 +1392,7 @@ impl World {
             return Err(StepError::InvalidDt(dt));
         }
         let start = Stopwatch::start();
-        if self.settled && !self.paths {
+        if self.settled {
             // Nothing is awake or moving and nothing changed since the last step, which found
             // nothing to do: this one would find the same. Only the clock moves on.
             self.narrow.clear_events();

@@ -696,7 +696,8 @@ impl DirectIslands {
         self.chain_roots.clear();
         for b in 0..states.len() as u32 {
             let r = b as usize;
-            if self.row_count[r] == 0 || self.sets.find(b) != b {
+            // Rows are counted at their island's root only.
+            if self.row_count[r] == 0 {
                 continue;
             }
             let heavy = self.mixed[r] && self.row_count[r] <= max_rows;
