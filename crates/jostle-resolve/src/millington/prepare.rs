@@ -40,9 +40,12 @@ pub struct PreparedContact {
     /// (accumulated clamping); recomputed after each of them, as the lecture does, the rule
     /// bounced what a neighbouring point's pick had driven into the surface, and a box landing
     /// on an edge gained energy at every impact (benches/RESULTS.md, "Restitution 1 never
-    /// raises a bounce"). A pick of another pair is a new collision for the contact: its target
-    /// is decided again from the velocity that pick left ([`super::velocity::update_velocity`]),
-    /// so an impact passed on through touching bodies (Newton's cradle) travels pair by pair.
+    /// raises a bounce"). A pick of another pair that drives the contact together is a new
+    /// collision for it: its target is decided again from the velocity that pick left
+    /// ([`super::velocity::update_velocity`]), so an impact passed on through touching bodies
+    /// (Newton's cradle) travels pair by pair. Driven apart, a resting contact (a target of at
+    /// most 0) keeps its target and may take back its push; a bouncing one keeps the
+    /// separation it was given.
     pub target_velocity: f32,
     /// For a speculative contact (negative penetration: a gap), the closing speed the gap
     /// absorbs within the step, gap/dt (m/s); zero for touching or overlapping contacts. Set

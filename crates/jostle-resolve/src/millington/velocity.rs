@@ -416,7 +416,8 @@ pub fn resolve_velocity(p: &mut PreparedContact, bodies: &mut [SolverBody]) -> B
 /// to bodies it may share: Δv_contact = ±Mᵀ(Δv + Δω × r), + for side A, − for side B. The
 /// desired change is what is left to the contact's target ([`PreparedContact::target_velocity`]);
 /// a change made by a contact between other bodies decides the target again, by the
-/// micro-collision rule from the new velocity (a push only).
+/// micro-collision rule from the new velocity, where the rule wants a push or the contact was
+/// bouncing (a target above 0); a resting contact driven apart keeps its target.
 /// Returns whether `p` shared a body with the change.
 pub fn update_velocity(p: &mut PreparedContact, change: &BodyChange, velocity_limit: f32) -> bool {
     update_velocity_for(p, change, change.body, velocity_limit)
@@ -444,8 +445,14 @@ pub fn update_velocity_for(
     if touched {
         let same_pair = pair == p.body || pair == [p.body[1], p.body[0]];
         if !same_pair && !p.held {
-            // A new collision, or nothing to do: what the other pair's pick left is kept
-            // unless the micro-collision rule wants a push.
+            // A new collision, or nothing to do: the micro-collision rule decides the target
+            // again when it wants a push. Driven apart instead, a bouncing contact keeps what
+            // the other pair's pick left (its impact was passed on: Newton's cradle), and a
+            // resting one keeps its target, so that it may take back what it pushed: kept at
+            // the separation instead, it could not, and a pick that had pushed a box up was
+            // never undone (a pyramid with a heavy top stepped at `dt` 1.0 rose 0.2 m and
+            // gained 329 kJ in its first step; benches/RESULTS.md, "Resting contacts driven
+            // apart take back their push").
             let desired = desired_delta_velocity(
                 p.velocity.x,
                 p.acc_velocity,
@@ -454,7 +461,9 @@ pub fn update_velocity_for(
                 velocity_limit,
                 p.gap_velocity,
             );
-            p.target_velocity = p.velocity.x + desired.max(0.0);
+            if desired > 0.0 || p.target_velocity > 0.0 {
+                p.target_velocity = p.velocity.x + desired.max(0.0);
+            }
         }
         p.desired_delta_velocity = p.target_velocity - p.velocity.x;
     }
