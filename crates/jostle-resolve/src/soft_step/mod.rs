@@ -400,7 +400,13 @@ impl SoftStepResolver {
         self.rows_inverse.resize(bodies.len(), Mat3::ZERO);
         self.touches_moving.resize(bodies.len(), false);
         let moves = |k: u32| bodies.get(k as usize).is_some_and(|b| b.inv_mass > 0.0);
+        let mut last = None;
         for c in contacts {
+            // A manifold's points come one after another and mark the same two bodies.
+            if last == Some((c.a, c.b)) {
+                continue;
+            }
+            last = Some((c.a, c.b));
             let both = moves(c.a) && moves(c.b);
             for k in [c.a, c.b] {
                 if k != STATIC_BODY
