@@ -27,12 +27,21 @@
 use super::lanes::{F8, Lane, V3x8, WIDTH};
 use super::prepare::{PrepareParams, prepare_batches};
 use crate::{Contact, STATIC_BODY, SolverBody};
+use jostle_math::Vec3;
 
 /// Manifolds per batch: the lane count of [`super::lanes`].
 pub const LANES: usize = WIDTH;
 
 /// Most contact points per manifold lane.
 pub const MAX_POINTS: usize = 4;
+
+/// A manifold whose normal makes an angle of more than 60° with gravity is packed with the
+/// others like it ([`Batches::pack`]).
+const SIDE_COSINE: f32 = 0.5;
+
+/// Bodies per block within which [`Batches::pack`] groups the manifolds near horizontal: a
+/// colour stays ordered by body from block to block, as the team's threads want it.
+const SIDE_BLOCK: u32 = 256;
 
 /// Colours of one round of colouring (one bit each in a body's mask).
 const ROUND_COLOURS: u32 = 64;
@@ -141,6 +150,11 @@ pub struct ManifoldLanes<F = F8> {
     /// [`ManifoldLanes::inv_mass_a`] axis by axis, otherwise through its x component alone
     /// (which is 0 for a body locked along every axis, as its other components are).
     pub locked: bool,
+    /// Whether every lane's normal lies within 60° of horizontal under gravity
+    /// ([`Batches::pack`] groups such manifolds): they carry little load, the block solution
+    /// would pull in most of them, so the relax pass solves their points one by one
+    /// ([`super::solve::relax`]) and no block is factored for them.
+    pub side: bool,
     /// Lanes (bit l for lane l) whose body A keeps its warm start point by point in every
     /// substep ([`super::body_state::EXACT_WARM`]); set after packing.
     pub exact_a: u8,
@@ -183,6 +197,8 @@ pub struct Batches {
     counts: Vec<u32>,
     runs: Vec<Run>,
     order: Vec<u32>,
+    /// Each run's place within its colour (`Batches::pack`).
+    keys: Vec<u128>,
     /// Input indices of the contacts that take part, in input order.
     kept: Vec<u32>,
 }
@@ -350,22 +366,32 @@ impl Batches {
         // Within a colour, by body: the lower movable body's index, then input order. The
         // threads of a step's team each take a contiguous part of every colour
         // ([`super::team`]), so each keeps touching about the same bodies from colour to
-        // colour, and the body states stay in its core's cache.
-        let key = |r: &Run| {
+        // colour, and the body states stay in its core's cache. Within each block of
+        // `SIDE_BLOCK` bodies the manifolds whose normal lies within 60° of horizontal come
+        // first: under gravity they carry little load, and the relax pass's block solution
+        // pulls in most of them, which sends the whole batch back point by point
+        // (`solve::relax_block`); grouped, they take fewer batches with them. Each lane is
+        // solved on its own, so the order changes no result.
+        let down = params.down;
+        self.keys.clear();
+        self.keys.extend(self.runs.iter().map(|r| {
             let c = &contacts[kept[r.start as usize] as usize];
             let body = match (c.a, c.b) {
                 (STATIC_BODY, b) => b,
                 (a, STATIC_BODY) => a,
                 (a, b) => a.min(b),
             };
-            (u64::from(body) << 32) | u64::from(r.start)
-        };
+            let side = down != Vec3::ZERO && c.normal.dot(down).abs() < SIDE_COSINE;
+            (u128::from(body / SIDE_BLOCK) << 96)
+                | (u128::from(!side) << 64)
+                | (u128::from(body) << 32)
+                | u128::from(r.start)
+        }));
         // (`counts[c]` now ends colour c.)
         let mut begin = 0;
         for &end in counts.iter().take(COLOURS as usize) {
-            let runs = &self.runs;
-            self.order[begin as usize..end as usize]
-                .sort_unstable_by_key(|&i| key(&runs[i as usize]));
+            let keys = &self.keys;
+            self.order[begin as usize..end as usize].sort_unstable_by_key(|&i| keys[i as usize]);
             begin = end;
         }
 
@@ -392,7 +418,9 @@ impl Batches {
             for (l, run) in batch_runs.iter_mut().enumerate().take(lanes) {
                 *run = self.runs[self.order[k + l] as usize];
             }
-            self.push_batch(&batch_runs[..lanes], contacts);
+            // Near horizontal: the key's bit 64 (`!side`) is clear.
+            let side = (0..lanes).all(|l| self.keys[self.order[k + l] as usize] & (1 << 64) == 0);
+            self.push_batch(&batch_runs[..lanes], contacts, side);
             k += lanes;
         }
         self.groups.push(self.manifolds.len() as u32);
@@ -410,7 +438,8 @@ impl Batches {
 
     /// Appends one batch holding `runs` (at most [`LANES`]) in lanes 0, 1, ...: its bodies,
     /// its points' sources; [`prepare_batches`] then writes the points.
-    fn push_batch(&mut self, runs: &[Run], contacts: &[Contact]) {
+    /// `side`: every run's normal lies within 60° of horizontal ([`ManifoldLanes::side`]).
+    fn push_batch(&mut self, runs: &[Run], contacts: &[Contact], side: bool) {
         debug_assert!(!runs.is_empty() && runs.len() <= LANES);
         let count = runs.iter().map(|r| r.len).max().unwrap_or(0);
         let first = self.sources.len() as u32;
@@ -441,6 +470,7 @@ impl Batches {
             count,
             friction,
             locked: false,
+            side,
             exact_a: 0,
             exact_b: 0,
             block: [F8::ZERO; BLOCK_ENTRIES],
@@ -474,6 +504,7 @@ mod tests {
             preload_ramp: 0.0,
             preload_bound: 0.0,
             step: 0.0,
+            down: Vec3::ZERO,
         }
     }
 
@@ -527,6 +558,58 @@ mod tests {
         assert_eq!(batches.colours, 2);
         assert_eq!(batches.manifolds.len(), 2 + 2);
         assert_eq!(batches.overflow, 0);
+    }
+
+    #[test]
+    fn manifolds_near_horizontal_get_batches_of_their_own_under_gravity() {
+        // 40 boxes on the ground (4-point manifolds, normal up), each also touching its
+        // neighbour side by side (4-point manifolds, normal along x): the side manifolds
+        // alternate with the others in the input.
+        let mut contacts = Vec::new();
+        for i in 1..41u32 {
+            for p in 0..4 {
+                let point = Vec3::new(i as f32 + 0.1 * p as f32, 0.0, 0.0);
+                contacts.push(Contact::new(i, 0, point, Vec3::Y, 0.001).with_friction(0.5));
+            }
+            if i < 40 {
+                for p in 0..4 {
+                    let point = Vec3::new(i as f32 + 0.5, 0.5, 0.1 * p as f32);
+                    contacts.push(Contact::new(i, i + 1, point, Vec3::X, 0.0).with_friction(0.5));
+                }
+            }
+        }
+        let lanes_of = |batches: &Batches, side: bool| {
+            batches
+                .manifolds
+                .iter()
+                .filter(|m| m.side == side)
+                .map(|m| m.a.iter().filter(|&&a| a != STATIC_BODY).count())
+                .sum::<usize>()
+        };
+        let down = PrepareParams {
+            down: Vec3::NEG_Y,
+            ..params()
+        };
+        let mut batches = Batches::default();
+        batches.pack(&contacts, &bodies(40), 0.02, &down);
+        // All 39 side manifolds in side batches (the ground's 40 in the others), and no more
+        // side batches than their lanes need in each colour.
+        assert_eq!(lanes_of(&batches, true), 39);
+        assert_eq!(lanes_of(&batches, false), 40);
+        for m in batches.manifolds.iter().filter(|m| m.side) {
+            let first = m.first as usize;
+            for p in &batches.sources[first..first + m.count as usize] {
+                for &i in p.iter().filter(|&&i| i != NO_SOURCE) {
+                    assert_eq!(contacts[i as usize].normal, Vec3::X);
+                }
+            }
+        }
+        let mut seen: Vec<u32> = batches.lanes().map(|(_, _, s)| s).collect();
+        seen.sort_unstable();
+        assert_eq!(seen, (0..contacts.len() as u32).collect::<Vec<_>>());
+        // Without gravity there is no horizontal: no batch is a side batch.
+        batches.pack(&contacts, &bodies(40), 0.02, &params());
+        assert_eq!(lanes_of(&batches, true), 0);
     }
 
     #[test]

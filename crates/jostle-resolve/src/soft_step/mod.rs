@@ -527,7 +527,7 @@ impl SoftStepResolver {
         bodies: &[SolverBody],
         contacts: &[Contact],
         h: f32,
-        gravity: f32,
+        gravity: jostle_math::Vec3,
     ) -> bool {
         let s = &self.settings;
         // A spring stiffer than a quarter of the substep rate is not resolved by the substep
@@ -558,11 +558,13 @@ impl SoftStepResolver {
             },
             preload_bound: if s.preload_rate > 0.0 && !s.rigid_contacts {
                 // Finite for any settings, so that padding lanes (zero mass) stay at 0.
-                ((s.damping_ratio / PRELOAD_MIN_DAMPING).powi(2) * gravity * h).min(f32::MAX)
+                ((s.damping_ratio / PRELOAD_MIN_DAMPING).powi(2) * gravity.length() * h)
+                    .min(f32::MAX)
             } else {
                 0.0
             },
             step: h * s.substeps.max(1) as f32,
+            down: gravity.normalize_or_zero(),
         };
         self.batches
             .pack(contacts, bodies, s.speculative_margin, &params);
@@ -952,7 +954,7 @@ impl Resolver for SoftStepResolver {
 
         let start = Stopwatch::start();
         self.load_bodies(bodies);
-        let any_restitution = self.prepare_contacts(bodies, contacts, h, ctx.gravity.length());
+        let any_restitution = self.prepare_contacts(bodies, contacts, h, ctx.gravity);
         self.mark_contact_rows(bodies, contacts);
         self.mark_free();
         let exact_warm = self.mark_exact_warm();

@@ -40,6 +40,9 @@ pub struct PrepareParams {
     /// the step, close the gap beyond the margin within it ([`super::Batches::pack`]); 0:
     /// none beyond the margin.
     pub step: f32,
+    /// Gravity's direction (unit), or zero without gravity: [`super::Batches::pack`] groups
+    /// the manifolds whose normal lies within 60° of horizontal into batches of their own.
+    pub down: Vec3,
 }
 
 /// The step-start state of eight bodies, by lane, as preparation reads it.
@@ -328,6 +331,7 @@ mod tests {
             preload_ramp: 0.0,
             preload_bound: 0.0,
             step: 0.0,
+            down: Vec3::ZERO,
         };
         let mut batches = Batches::default();
         batches.pack(&scene.contacts, &scene.bodies, 0.02, &params);
@@ -384,6 +388,7 @@ mod tests {
             preload_ramp: 0.0,
             preload_bound: 0.0,
             step: 0.0,
+            down: Vec3::ZERO,
         };
         for _ in 0..50 {
             let contacts: Vec<Contact> = (0..WIDTH - 1)

@@ -102,7 +102,11 @@ pub struct SoftStepSettings {
     /// solved together, the default"): columns of 5 to 60 boxes of 0.1, 1 and 10 m at μ 0.3,
     /// 0.6 and 0.9, started at rest, all 504 keep every box within 7.3 mm of its start over
     /// 20 s (point by point 437, and columns of 21, 43 and 49 boxes of 10 m fall); 8% more
-    /// time per step on the 20-row pyramid.
+    /// time per step on the 20-row pyramid. Under gravity, manifolds whose normal lies within
+    /// 60° of horizontal (boxes side by side) are packed into batches of their own and solved
+    /// point by point: they carry little load, and their block solution pulled in 93% of
+    /// them, sending the whole batch back point by point (benches/RESULTS.md, "Manifolds side
+    /// by side solved point by point").
     pub block_relax: bool,
     /// Rigid contacts instead of springs. Default false.
     ///

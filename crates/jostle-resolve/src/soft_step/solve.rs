@@ -819,7 +819,7 @@ pub fn factor_blocks(batches: &mut Batches) {
 
 #[inline(always)]
 fn factor_blocks_impl<F: Lane>(manifolds: &mut [ManifoldLanes<F>], points: &mut [PointLanes<F>]) {
-    for m in manifolds.iter_mut() {
+    for m in manifolds.iter_mut().filter(|m| !m.side) {
         let first = m.first as usize;
         let pts = &points[first..first + m.count as usize];
         m.block = factor_block::<F>(m, pts);
@@ -899,6 +899,13 @@ fn relax_block<F: Lane, L: LinearResponse<F>>(
     inv_h: F,
 ) {
     store_separations(m, points, states);
+    if m.side {
+        // Near horizontal: point by point, as a lane whose block solution pulls.
+        for p in points.iter_mut() {
+            relax_point(m, pair, p, inv_h);
+        }
+        return;
+    }
     let mut b = [F::ZERO; MAX_POINTS];
     // The block serves lanes with two or more points (a single point's row is exact point by
     // point, and the regularisation would only under-relax it). A speculative point keeps its
@@ -1300,26 +1307,39 @@ fn relax_impl<F: Lane>(
     let mut rest = manifolds;
     if block {
         // Block relax (`SoftStepSettings::block_relax`). (Two batches interleaved, as below,
-        // measured no faster here.)
+        // measured no faster here.) Two batches near horizontal, solved point by point, are
+        // interleaved as the plain relax's are.
         let inv_h_lanes = F::splat(inv_h);
-        for_each_batch!(
-            manifolds,
-            points,
-            base,
-            states,
-            |m, pair, points, states| {
-                relax_block(m, pair, points, states, inv_h_lanes);
+        let mut i = 0;
+        while i < manifolds.len() {
+            let m0 = &manifolds[i];
+            if let Some(m1) = manifolds.get(i + 1)
+                && m0.side
+                && m1.side
+                && !m0.locked
+                && !m1.locked
+            {
+                relax_two(m0, m1, points, base, states, inv_h_lanes);
+                i += 2;
+                continue;
             }
-        );
+            for_each_batch!(
+                std::slice::from_ref(m0),
+                &mut *points,
+                base,
+                states,
+                |m, pair, points, states| {
+                    relax_block(m, pair, points, states, inv_h_lanes);
+                }
+            );
+            i += 1;
+        }
         return;
     }
     if sweeps == 1 {
-        // Two batches at a time, their points interleaved: each point's rows depend on the
-        // velocities the point before left, so one batch is a single chain of dependent
-        // operations; two independent chains keep the CPU busier (20-row pyramid, resolve stage
-        // on one thread: 0.399 → 0.379 ms; the same interleave in the biased pass gained
-        // nothing). Same arithmetic per lane, and the batches of one colour share no body: the
-        // results are bit for bit those of one batch after the other.
+        // Two batches at a time, their points interleaved (`relax_two`; 20-row pyramid,
+        // resolve stage on one thread: 0.399 → 0.379 ms; the same interleave in the biased
+        // pass gained nothing).
         let inv_h_lanes = F::splat(inv_h);
         let mut twos = manifolds.chunks_exact(2);
         for two in &mut twos {
@@ -1337,27 +1357,44 @@ fn relax_impl<F: Lane>(
                 );
                 continue;
             }
-            let (p0, p1) = two_batches(points, base, m0, m1);
-            let mut pair0 = Pair::load_plain(m0, states);
-            let mut pair1 = Pair::load_plain(m1, states);
-            store_separations(m0, p0, states);
-            store_separations(m1, p1, states);
-            for k in 0..p0.len().max(p1.len()) {
-                if let Some(p) = p0.get_mut(k) {
-                    relax_point(m0, &mut pair0, p, inv_h_lanes);
-                }
-                if let Some(p) = p1.get_mut(k) {
-                    relax_point(m1, &mut pair1, p, inv_h_lanes);
-                }
-            }
-            pair0.store(m0, states);
-            pair1.store(m1, states);
+            relax_two(m0, m1, points, base, states, inv_h_lanes);
         }
         rest = twos.remainder();
     }
     for_each_batch!(rest, points, base, states, |m, pair, points, states| {
         relax_batch(m, pair, points, states, inv_h, sweeps);
     });
+}
+
+/// The single relax sweep over two batches of one colour (neither with a translation lock),
+/// their points interleaved: each point's rows depend on the velocities the point before
+/// left, so one batch is a single chain of dependent operations; two independent chains keep
+/// the CPU busier. Same arithmetic per lane as one batch after the other, and the batches of
+/// one colour share no body: the same results bit for bit.
+#[inline(always)]
+fn relax_two<F: Lane>(
+    m0: &ManifoldLanes<F>,
+    m1: &ManifoldLanes<F>,
+    points: &mut [PointLanes<F>],
+    base: u32,
+    states: &[Shared<BodyState>],
+    inv_h: F,
+) {
+    let (p0, p1) = two_batches(points, base, m0, m1);
+    let mut pair0 = Pair::load_plain(m0, states);
+    let mut pair1 = Pair::load_plain(m1, states);
+    store_separations(m0, p0, states);
+    store_separations(m1, p1, states);
+    for k in 0..p0.len().max(p1.len()) {
+        if let Some(p) = p0.get_mut(k) {
+            relax_point(m0, &mut pair0, p, inv_h);
+        }
+        if let Some(p) = p1.get_mut(k) {
+            relax_point(m1, &mut pair1, p, inv_h);
+        }
+    }
+    pair0.store(m0, states);
+    pair1.store(m1, states);
 }
 
 /// Stores each point's separation at the bodies' poses now ([`separation`]).
@@ -1854,6 +1891,7 @@ mod tests {
             preload_ramp: 2000.0,
             preload_bound: 1600.0 * 9.81 * h,
             step: 0.0,
+            down: jostle_math::Vec3::ZERO,
         };
         let mut batches = Batches::default();
         // Preloads on every contact, so the kernels' preload path is exercised too.
