@@ -363,6 +363,16 @@ pub fn variations() -> Vec<Case> {
     out
 }
 
+/// Whether the case `name` is selected by `only` (`FAMILY_ONLY`): its name contains one of
+/// the `|`-separated parts, or, for a part that starts with `^`, begins with the rest
+/// (`^pyramid 20` leaves out `3D pyramid 20`).
+pub fn selected(name: &str, only: &str) -> bool {
+    only.split('|').any(|part| match part.strip_prefix('^') {
+        Some(head) => name.starts_with(head),
+        None => name.contains(part),
+    })
+}
+
 /// The default variant started perturbed from `seed`.
 pub fn seeded(seed: u64) -> Variant {
     Variant {

@@ -15,7 +15,8 @@
 //! boxes on light ones (`family::heavy_sweep`), `FAMILY=heavy_seeds` the same from many more
 //! seeds (`family::heavy_seeds`), `FAMILY=tall` the tall members' variations
 //! (`family::tall_variations`); `FAMILY_ONLY` keeps the cases whose
-//! name contains one of its `|`-separated parts, as in `family_table`). With `--test` (`cargo
+//! name contains one of its `|`-separated parts, or begins with a part written `^part`, as in
+//! `family_table`). With `--test` (`cargo
 //! test -p jostle-compare --benches`) only a short smoke run is made.
 
 #[path = "../../../tests/common/family.rs"]
@@ -78,7 +79,7 @@ fn main() {
         }
     }
     let only = std::env::var("FAMILY_ONLY").unwrap_or_default();
-    cases.retain(|c| only.split('|').any(|part| c.name.contains(part)));
+    cases.retain(|c| family::selected(&c.name, &only));
     let seconds = if smoke { 0.5 } else { 20.0 };
     if smoke {
         cases.truncate(2);

@@ -12,7 +12,10 @@
 //! 4. the **velocity pass**: per island, worst velocity change first (the desired normal
 //!    change, or the sliding speed of a contact whose friction can still act), an impulse per
 //!    pick ([`velocity`]), updating the closing velocity of every contact sharing a body,
-//!    warm started from the impulses the contacts carried from the last step;
+//!    warm started from the impulses the contacts carried from the last step; a pick for a
+//!    normal velocity resolves the normal velocities of the picked contact's whole manifold
+//!    together ([`velocity::resolve_manifold_normals`],
+//!    [`MillingtonSettings::manifold_picks`]);
 //! 5. integrate the resolved velocities into poses
 //!    ([`crate::integrate::integrate_positions`]).
 //!
@@ -84,8 +87,9 @@ pub use settings::{IterationBudget, MillingtonSettings, PickStrategy, Projection
 pub use velocity::{
     DYNAMIC_FRICTION_MIN_RESPONSE, FRICTION_CAPACITY_TOLERANCE, FrictionPick, apply_impulse,
     contact_impulse, coulomb, coulomb_accumulated, friction_impulse, friction_pick,
-    frictionless_impulse, has_friction_capacity, impulse_matrix, reopen_friction, resolve_velocity,
-    update_velocity, velocity_change_per_unit_impulse, velocity_key,
+    frictionless_impulse, has_friction_capacity, impulse_matrix, reopen_friction,
+    resolve_manifold_normals, resolve_velocity, update_velocity, velocity_change_per_unit_impulse,
+    velocity_key,
 };
 
 use crate::clock::Stopwatch;
@@ -125,6 +129,9 @@ pub struct MillingtonResolver {
     bounce_marks: Vec<u8>,
     /// The shock sweep's levels and order ([`shock`]).
     shock: Shock,
+    /// Each contact's manifold, `start..end` (scratch, with
+    /// [`MillingtonSettings::manifold_picks`]).
+    manifolds: Vec<[u32; 2]>,
 }
 
 /// [`MillingtonResolver`]'s bounce marks: the body bounces off an immovable body.
@@ -259,6 +266,10 @@ impl MillingtonResolver {
                 settings.velocity_epsilon,
             );
         }
+        self.manifolds.clear();
+        if settings.manifold_picks {
+            manifold_ranges(&self.prepared, &self.islands, bodies, &mut self.manifolds);
+        }
         let mut pass = VelocityPass {
             contacts: &mut self.prepared,
             bodies,
@@ -266,6 +277,7 @@ impl MillingtonResolver {
             velocity_epsilon: settings.velocity_epsilon,
             picked: u32::MAX,
             picked_pair: [change::NO_BODY; 2],
+            manifolds: &self.manifolds,
         };
         stats.velocity_iterations = run_pass(
             &mut pass,
@@ -415,6 +427,52 @@ fn warm_start(
         }
         if changed {
             p.desired_delta_velocity = p.target_velocity - p.velocity.x;
+        }
+    }
+}
+
+/// Each contact's manifold as `start..end` into `prepared`: runs of consecutive contacts
+/// between the same two moving bodies (in the same order), at most
+/// [`velocity::MANIFOLD_POINTS`] long. A contact with no moving body, and every contact of an
+/// island that holds a mass ratio of [`shock::SHOCK_MASS_RATIO`] or more, is a run of its own:
+/// there a pick that takes back a loaded point's push moves a light body by the heavy one's
+/// load, and solved as a block 9 of the 72 heavy-on-light cases lost a box (benches/RESULTS.md,
+/// "Picks by manifold"); the shock sweep holds such islands point by point.
+fn manifold_ranges(
+    prepared: &[PreparedContact],
+    islands: &Islands,
+    bodies: &[SolverBody],
+    out: &mut Vec<[u32; 2]>,
+) {
+    let mut start = 0;
+    while start < prepared.len() {
+        let body = prepared[start].body;
+        let mut end = start + 1;
+        if body != [change::NO_BODY; 2] {
+            while end < prepared.len()
+                && end - start < velocity::MANIFOLD_POINTS
+                && prepared[end].body == body
+            {
+                end += 1;
+            }
+        }
+        out.extend(std::iter::repeat_n([start as u32, end as u32], end - start));
+        start = end;
+    }
+    let inv_mass = |k: u32| bodies.get(k as usize).map_or(0.0, |b| b.inv_mass);
+    for i in 0..islands.len() {
+        let island = islands.island(i);
+        let ratio = island.iter().any(|&c| match prepared[c as usize].body {
+            [a, b] if a != change::NO_BODY && b != change::NO_BODY => {
+                let (ia, ib) = (inv_mass(a), inv_mass(b));
+                ia.max(ib) >= shock::SHOCK_MASS_RATIO * ia.min(ib)
+            }
+            _ => false,
+        });
+        if ratio {
+            for &c in island {
+                out[c as usize] = [c, c + 1];
+            }
         }
     }
 }

@@ -5,7 +5,10 @@ use super::change::BodyChange;
 use super::position::{position_key, resolvable, resolve_penetration, update_penetration};
 use super::prepare::PreparedContact;
 use super::settings::MillingtonSettings;
-use super::velocity::{reopen_friction, resolve_velocity, update_velocity_for, velocity_key};
+use super::velocity::{
+    normal_key, reopen_friction, resolve_manifold_normals, resolve_velocity, update_velocity_for,
+    velocity_key,
+};
 use super::worst_first::Pass;
 use crate::SolverBody;
 
@@ -70,6 +73,9 @@ pub(crate) struct VelocityPass<'a> {
     /// Its two bodies, as the contact has them: the pair the last pick was made for, even
     /// where it held one of them still ([`update_velocity_for`]).
     pub(crate) picked_pair: [u32; 2],
+    /// Each contact's manifold, `start..end` in `contacts`, when picks are by manifold
+    /// ([`MillingtonSettings::manifold_picks`]); empty otherwise.
+    pub(crate) manifolds: &'a [[u32; 2]],
 }
 
 impl Pass for VelocityPass<'_> {
@@ -88,9 +94,26 @@ impl Pass for VelocityPass<'_> {
         velocity_key(&self.contacts[contact as usize])
     }
 
+    /// With [`MillingtonSettings::manifold_picks`], a contact picked for its normal velocity
+    /// resolves its manifold's normal velocities together
+    /// ([`resolve_manifold_normals`]) unless that block cannot resolve it; otherwise, and
+    /// for sliding, [`resolve_velocity`] alone.
     fn resolve(&mut self, contact: u32) -> Option<BodyChange> {
         self.picked = contact;
         self.picked_pair = self.contacts[contact as usize].body;
+        if let Some(&[start, end]) = self.manifolds.get(contact as usize) {
+            let p = &self.contacts[contact as usize];
+            if end - start >= 2 && velocity_key(p) <= normal_key(p) {
+                let range = start as usize..end as usize;
+                if let Some(change) = resolve_manifold_normals(
+                    &mut self.contacts[range],
+                    (contact - start) as usize,
+                    self.bodies,
+                ) {
+                    return Some(change);
+                }
+            }
+        }
         Some(resolve_velocity(
             &mut self.contacts[contact as usize],
             self.bodies,
