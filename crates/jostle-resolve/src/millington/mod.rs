@@ -459,17 +459,9 @@ fn manifold_ranges(
         out.extend(std::iter::repeat_n([start as u32, end as u32], end - start));
         start = end;
     }
-    let inv_mass = |k: u32| bodies.get(k as usize).map_or(0.0, |b| b.inv_mass);
     for i in 0..islands.len() {
         let island = islands.island(i);
-        let ratio = island.iter().any(|&c| match prepared[c as usize].body {
-            [a, b] if a != change::NO_BODY && b != change::NO_BODY => {
-                let (ia, ib) = (inv_mass(a), inv_mass(b));
-                ia.max(ib) >= shock::SHOCK_MASS_RATIO * ia.min(ib)
-            }
-            _ => false,
-        });
-        if ratio {
+        if shock::holds_mass_ratio(island, prepared, bodies) {
             for &c in island {
                 out[c as usize] = [c, c + 1];
             }

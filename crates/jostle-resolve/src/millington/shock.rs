@@ -67,6 +67,23 @@ pub(crate) struct Shock {
     swept: Vec<bool>,
 }
 
+/// Whether the contacts `island` (indices into `contacts`) join two movable bodies whose
+/// masses are [`SHOCK_MASS_RATIO`] or more apart.
+pub(crate) fn holds_mass_ratio(
+    island: &[u32],
+    contacts: &[PreparedContact],
+    bodies: &[SolverBody],
+) -> bool {
+    island.iter().any(|&c| match contacts[c as usize].body {
+        [a, b] if a != NO_BODY && b != NO_BODY => {
+            let mass = |k: u32| bodies.get(k as usize).map_or(0.0, |b| b.inv_mass);
+            let (ia, ib) = (mass(a), mass(b));
+            ia.max(ib) >= SHOCK_MASS_RATIO * ia.min(ib)
+        }
+        _ => false,
+    })
+}
+
 impl Shock {
     /// Forgets the last step's order.
     pub(crate) fn reset(&mut self) {
@@ -81,15 +98,7 @@ impl Shock {
         self.swept.resize(contacts.len(), false);
         for i in 0..islands.len() {
             let island = islands.island(i);
-            let ratio = island.iter().any(|&c| match contacts[c as usize].body {
-                [a, b] if a != NO_BODY && b != NO_BODY => {
-                    let mass = |k: u32| bodies.get(k as usize).map_or(0.0, |b| b.inv_mass);
-                    let (ia, ib) = (mass(a), mass(b));
-                    ia.max(ib) >= SHOCK_MASS_RATIO * ia.min(ib)
-                }
-                _ => false,
-            });
-            if ratio {
+            if holds_mass_ratio(island, contacts, bodies) {
                 for &c in island {
                     self.swept[c as usize] = true;
                 }
