@@ -370,8 +370,10 @@ impl Batches {
         // `SIDE_BLOCK` bodies the manifolds whose normal lies within 60° of horizontal come
         // first: under gravity they carry little load, and the relax pass's block solution
         // pulls in most of them, which sends the whole batch back point by point
-        // (`solve::relax_block`); grouped, they take fewer batches with them. Each lane is
-        // solved on its own, so the order changes no result.
+        // (`solve::relax_block`); grouped, they fill batches of their own, which the relax
+        // pass solves point by point (`ManifoldLanes::side`; a side manifold packed with
+        // others is solved by the block as they are). Each lane is solved on its own, so
+        // beyond deciding which batches are side batches the order changes no result.
         let down = params.down;
         self.keys.clear();
         self.keys.extend(self.runs.iter().map(|r| {

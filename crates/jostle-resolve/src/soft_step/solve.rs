@@ -1306,8 +1306,8 @@ fn relax_impl<F: Lane>(
 ) {
     let mut rest = manifolds;
     if block {
-        // Block relax (`SoftStepSettings::block_relax`). (Two batches interleaved, as below,
-        // measured no faster here.) Two batches near horizontal, solved point by point, are
+        // Block relax (`SoftStepSettings::block_relax`). (Two block batches interleaved, as
+        // below, measured no faster here.) Two side batches, solved point by point, are
         // interleaved as the plain relax's are.
         let inv_h_lanes = F::splat(inv_h);
         let mut i = 0;
