@@ -203,7 +203,10 @@ struct Computed {
     pos12: Pose,
     prediction: f32,
     /// Identities (addresses) of the two shapes, so a replaced shape forces a recompute.
-    /// Meaningless once serialised: [`NarrowPhase::rebind_shapes`] refreshes them on restore.
+    /// Not serialised (an address would make the snapshots of two identical runs differ, and
+    /// means nothing in another process): [`NarrowPhase::rebind_shapes`] sets them on
+    /// restore.
+    #[cfg_attr(feature = "serde", serde(skip))]
     shapes: (usize, usize),
 }
 
