@@ -201,6 +201,21 @@ pub struct Batches {
     keys: Vec<u128>,
     /// Input indices of the contacts that take part, in input order.
     kept: Vec<u32>,
+    /// What the layout of the last full packing was decided from, one entry per contact
+    /// that took part ([`Batches::pack`]): its input index, its bodies and its flags
+    /// ([`layout_flags`]).
+    layout: Vec<[u32; 4]>,
+    /// `manifolds`, `sources` and `groups` lengths that the last full packing left, or
+    /// `None` before the first one: a layout is reused only if they are unchanged.
+    layout_lengths: Option<[usize; 3]>,
+}
+
+/// The flags of a contact that [`Batches::pack`]'s layout depends on besides its index and
+/// bodies: bit 0 whether its normal lies within 60° of horizontal under gravity, bit 1
+/// whether it has friction.
+fn layout_flags(c: &Contact, down: Vec3) -> u32 {
+    let side = down != Vec3::ZERO && c.normal.dot(down).abs() < SIDE_COSINE;
+    u32::from(side) | (u32::from(c.friction > 0.0) << 1)
 }
 
 /// How fast the bodies of `c` close its gap at its points (m/s; 0 when they do not): the
@@ -232,6 +247,14 @@ impl Batches {
     /// least one can move, with a gap of at most `speculative_margin` (m), or of at most
     /// the margin plus what the bodies close within [`PrepareParams::step`] at their
     /// velocities (a speculative contact ahead of a fast body); the others take no part.
+    ///
+    /// The layout (which manifold goes to which batch and lane) depends only on which
+    /// contacts take part, their bodies, whether each has friction and whether its normal
+    /// lies within 60° of horizontal. When all of these are as at the last packing (a
+    /// resting pile: the same pairs step after step) the batches keep that layout and only
+    /// their contents are prepared again: the same result as packing afresh, without the
+    /// colouring and sorting. A caller that edits `manifolds`, `sources` or `groups` by
+    /// hand between two packings must call [`Batches::forget_layout`].
     pub fn pack(
         &mut self,
         contacts: &[Contact],
@@ -239,18 +262,11 @@ impl Batches {
         speculative_margin: f32,
         params: &PrepareParams,
     ) {
-        self.manifolds.clear();
-        // `points` keeps its length from the last step: every point is overwritten by the
-        // preparation, so only a growth needs filling (a step's 1.5 kB per point is otherwise
-        // written twice).
-        self.sources.clear();
-        self.runs.clear();
-        self.kept.clear();
-        self.colour_mask.clear();
-        self.colour_mask.resize(bodies.len(), 0);
-        self.colours = 0;
-        self.overflow = 0;
         self.any_restitution = false;
+        // Which contacts take part, compared entry by entry with the last layout's as they
+        // are found.
+        let mut same = self.layout_lengths.is_some();
+        let mut kept = 0;
         for (i, c) in contacts.iter().enumerate() {
             let (ba, bb) = (&bodies[c.a as usize], &bodies[c.b as usize]);
             let gap = -c.penetration;
@@ -264,11 +280,67 @@ impl Batches {
                     "contact normal must be unit, got {}",
                     c.normal
                 );
-                self.kept.push(i as u32);
+                let entry = [i as u32, c.a, c.b, layout_flags(c, params.down)];
+                match self.layout.get_mut(kept) {
+                    Some(old) => {
+                        same &= *old == entry;
+                        *old = entry;
+                    }
+                    None => {
+                        same = false;
+                        self.layout.push(entry);
+                    }
+                }
+                kept += 1;
                 self.any_restitution |= c.restitution > 0.0;
             }
         }
-        self.contacts = self.kept.len() as u32;
+        same &= self.layout.len() == kept
+            && self.layout_lengths
+                == Some([self.manifolds.len(), self.sources.len(), self.groups.len()]);
+        self.layout.truncate(kept);
+        self.contacts = kept as u32;
+        if same {
+            for m in &mut self.manifolds {
+                // Set again by the resolver where it applies (`mark_exact_warm`).
+                (m.exact_a, m.exact_b) = (0, 0);
+            }
+        } else {
+            self.lay_out(contacts, bodies.len());
+            self.layout_lengths =
+                Some([self.manifolds.len(), self.sources.len(), self.groups.len()]);
+        }
+        prepare_batches(
+            &mut self.manifolds,
+            &mut self.points,
+            &self.sources,
+            contacts,
+            bodies,
+            params,
+        );
+    }
+
+    /// Makes the next [`Batches::pack`] lay the batches out afresh.
+    pub fn forget_layout(&mut self) {
+        self.layout_lengths = None;
+    }
+
+    /// Colours the manifolds of the contacts in `layout` and packs them into batches:
+    /// `manifolds` (their bodies and points, not yet prepared), `sources`, `groups`,
+    /// `colours` and `overflow`. `bodies`: how many bodies there are.
+    fn lay_out(&mut self, contacts: &[Contact], bodies: usize) {
+        self.manifolds.clear();
+        // `points` keeps its length from the last step: every point is overwritten by the
+        // preparation, so only a growth needs filling (a step's 1.5 kB per point is otherwise
+        // written twice).
+        self.sources.clear();
+        self.runs.clear();
+        self.kept.clear();
+        self.kept.extend(self.layout.iter().map(|e| e[0]));
+        self.colour_mask.clear();
+        self.colour_mask.resize(bodies, 0);
+        self.colours = 0;
+        self.overflow = 0;
 
         // Manifolds: runs of the same body pair, coloured by the colour masks: first all with
         // colours 0..64, then again those left with colours 64..128 and fresh masks, and so on.
@@ -374,7 +446,6 @@ impl Batches {
         // pass solves point by point (`ManifoldLanes::side`; a side manifold packed with
         // others is solved by the block as they are). Each lane is solved on its own, so
         // beyond deciding which batches are side batches the order changes no result.
-        let down = params.down;
         self.keys.clear();
         self.keys.extend(self.runs.iter().map(|r| {
             let c = &contacts[kept[r.start as usize] as usize];
@@ -383,7 +454,7 @@ impl Batches {
                 (a, STATIC_BODY) => a,
                 (a, b) => a.min(b),
             };
-            let side = down != Vec3::ZERO && c.normal.dot(down).abs() < SIDE_COSINE;
+            let side = self.layout[r.start as usize][3] & 1 != 0;
             (u128::from(body / SIDE_BLOCK) << 96)
                 | (u128::from(!side) << 64)
                 | (u128::from(body) << 32)
@@ -428,14 +499,6 @@ impl Batches {
         self.groups.push(self.manifolds.len() as u32);
         self.points
             .resize(self.sources.len(), PointLanes::default());
-        prepare_batches(
-            &mut self.manifolds,
-            &mut self.points,
-            &self.sources,
-            contacts,
-            bodies,
-            params,
-        );
     }
 
     /// Appends one batch holding `runs` (at most [`LANES`]) in lanes 0, 1, ...: its bodies,
@@ -612,6 +675,56 @@ mod tests {
         // Without gravity there is no horizontal: no batch is a side batch.
         batches.pack(&contacts, &bodies(40), 0.02, &params());
         assert_eq!(lanes_of(&batches, true), 0);
+    }
+
+    /// What `pack` decides: the batches, their points' sources and the groups.
+    fn layout_of(b: &Batches) -> (Vec<ManifoldLanes>, Vec<[u32; LANES]>, Vec<u32>, u32) {
+        (
+            b.manifolds.clone(),
+            b.sources.clone(),
+            b.groups.clone(),
+            b.colours,
+        )
+    }
+
+    #[test]
+    fn a_repacking_keeps_the_layout_only_while_it_would_be_the_same() {
+        let down = PrepareParams {
+            down: Vec3::NEG_Y,
+            ..params()
+        };
+        let fresh = |contacts: &[Contact]| {
+            let mut b = Batches::default();
+            b.pack(contacts, &bodies(21), 0.02, &down);
+            layout_of(&b)
+        };
+        let mut contacts = chain(21, 4);
+        let mut batches = Batches::default();
+        batches.pack(&contacts, &bodies(21), 0.02, &down);
+        // The same contacts, slightly moved: the layout is kept, and equals a fresh one.
+        for c in &mut contacts {
+            c.penetration += 0.0001;
+        }
+        batches.pack(&contacts, &bodies(21), 0.02, &down);
+        assert_eq!(layout_of(&batches), fresh(&contacts));
+        // Each change the layout depends on lays it out again, as a fresh packing would.
+        let changes: [fn(&mut Vec<Contact>); 5] = [
+            |c| c[4..8].iter_mut().for_each(|c| c.friction = 0.0),
+            |c| c[8..12].iter_mut().for_each(|c| c.normal = Vec3::X),
+            |c| c[13].penetration = -1.0,
+            |c| c.truncate(30),
+            |c| c.push(Contact::new(3, 0, Vec3::ZERO, Vec3::Y, 0.001)),
+        ];
+        for change in changes {
+            change(&mut contacts);
+            batches.pack(&contacts, &bodies(21), 0.02, &down);
+            assert_eq!(layout_of(&batches), fresh(&contacts));
+        }
+        // Edited by hand and forgotten: laid out again.
+        batches.manifolds.clear();
+        batches.forget_layout();
+        batches.pack(&contacts, &bodies(21), 0.02, &down);
+        assert_eq!(layout_of(&batches), fresh(&contacts));
     }
 
     #[test]
