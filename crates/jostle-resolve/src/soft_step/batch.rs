@@ -262,6 +262,27 @@ impl Batches {
         speculative_margin: f32,
         params: &PrepareParams,
     ) {
+        self.arrange(contacts, bodies, speculative_margin, params);
+        prepare_batches(
+            &mut self.manifolds,
+            &mut self.points,
+            &self.sources,
+            contacts,
+            bodies,
+            params,
+        );
+    }
+
+    /// [`Batches::pack`] without preparing the points: the batches, their bodies and their
+    /// points' sources, to be prepared by [`prepare_batches`] or, a run of batches at a
+    /// time, by [`super::prepare::prepare_batch_range`].
+    pub fn arrange(
+        &mut self,
+        contacts: &[Contact],
+        bodies: &[SolverBody],
+        speculative_margin: f32,
+        params: &PrepareParams,
+    ) {
         self.any_restitution = false;
         // Which contacts take part, compared entry by entry with the last layout's as they
         // are found.
@@ -310,14 +331,6 @@ impl Batches {
             self.layout_lengths =
                 Some([self.manifolds.len(), self.sources.len(), self.groups.len()]);
         }
-        prepare_batches(
-            &mut self.manifolds,
-            &mut self.points,
-            &self.sources,
-            contacts,
-            bodies,
-            params,
-        );
     }
 
     /// Makes the next [`Batches::pack`] lay the batches out afresh.

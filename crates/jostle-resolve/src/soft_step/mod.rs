@@ -521,14 +521,15 @@ impl SoftStepResolver {
         }
     }
 
-    /// Prepares the contacts; returns whether any has restitution.
-    fn prepare_contacts(
+    /// Packs the contacts into batches ([`Batches::arrange`]); returns the parameters their
+    /// points are prepared with ([`SoftStepResolver::prepare_points`]).
+    fn arrange_contacts(
         &mut self,
         bodies: &[SolverBody],
         contacts: &[Contact],
         h: f32,
         gravity: jostle_math::Vec3,
-    ) -> bool {
+    ) -> PrepareParams {
         let s = &self.settings;
         // A spring stiffer than a quarter of the substep rate is not resolved by the substep
         // and turns into jitter; Box2D v3 caps its contact hertz the same way.
@@ -567,8 +568,109 @@ impl SoftStepResolver {
             down: gravity.normalize_or_zero(),
         };
         self.batches
-            .pack(contacts, bodies, s.speculative_margin, &params);
-        self.batches.any_restitution
+            .arrange(contacts, bodies, s.speculative_margin, &params);
+        params
+    }
+
+    /// Prepares the points of the arranged batches ([`prepare::prepare_batches`]) and, with
+    /// the block relax, factors their blocks ([`solve::factor_blocks`]): on the team of
+    /// `threads` when there is more than one (each batch by the thread that will solve it,
+    /// so its points are in that thread's core's cache; [`Preparation`]), else in order on
+    /// this thread. Each batch is prepared and factored on its own: the same result either
+    /// way, bit for bit.
+    fn prepare_points(
+        &mut self,
+        contacts: &[Contact],
+        bodies: &[SolverBody],
+        params: &PrepareParams,
+        threads: usize,
+    ) {
+        let factor = self.settings.block_relax && !self.settings.rigid_contacts;
+        if threads <= 1 {
+            let b = &mut self.batches;
+            prepare::prepare_batches(
+                &mut b.manifolds,
+                &mut b.points,
+                &b.sources,
+                contacts,
+                bodies,
+                params,
+            );
+            if factor {
+                solve::factor_blocks(b);
+            }
+            return;
+        }
+        let Batches {
+            manifolds,
+            points,
+            sources,
+            groups,
+            ..
+        } = &mut self.batches;
+        let work = Preparation {
+            manifolds: share(manifolds),
+            points: share(points),
+            groups,
+            sources,
+            contacts,
+            bodies,
+            params,
+            factor,
+        };
+        let plan = Plan {
+            bounds: &self.bounds,
+            stages: Default::default(),
+        };
+        work.run(&plan);
+        self.plan.clear();
+        self.plan.append(&mut plan.stages.borrow_mut());
+        self.team.reset(threads, &self.plan);
+        team::run(&self.team, |member| work.run(member));
+    }
+}
+
+/// The preparation of a step's batches on a team ([`SoftStepResolver::prepare_points`]):
+/// each batch's points prepared from its contacts and, with `factor`, its block factored; one
+/// stage per group of batches, split among the threads as the substeps' stages are.
+struct Preparation<'a> {
+    manifolds: &'a [Shared<ManifoldLanes>],
+    points: &'a [Shared<PointLanes>],
+    /// [`Batches::groups`].
+    groups: &'a [u32],
+    /// [`Batches::sources`].
+    sources: &'a [[u32; batch::LANES]],
+    contacts: &'a [Contact],
+    bodies: &'a [SolverBody],
+    params: &'a PrepareParams,
+    factor: bool,
+}
+
+impl Preparation<'_> {
+    /// The preparation, stage by stage on `crew`.
+    fn run(&self, crew: &impl Crew) {
+        let (manifolds, points) = (self.manifolds, self.points);
+        each_batch_range(
+            crew,
+            manifolds,
+            points,
+            self.groups,
+            TEAM_BATCH_CHUNK,
+            |m, p, base| {
+                prepare::prepare_batch_range(
+                    m,
+                    p,
+                    base,
+                    self.sources,
+                    self.contacts,
+                    self.bodies,
+                    self.params,
+                );
+                if self.factor {
+                    solve::factor_block_range(m, p, base);
+                }
+            },
+        );
     }
 }
 
@@ -835,38 +937,20 @@ impl Substeps<'_> {
         }
     }
 
-    /// One stage per group of batches ([`Batches::groups`]), each item `f(manifolds,
-    /// points, base)` on a run of the group's batches, their points and the index of the
-    /// first.
+    /// [`each_batch_range`] over the substeps' batches.
     fn each_batch_range(
         &self,
         crew: &impl Crew,
         f: impl Fn(&mut [ManifoldLanes], &mut [PointLanes], u32),
     ) {
-        for group in self.groups.windows(2) {
-            let (start, end) = (group[0], group[1]);
-            let items = (end - start).div_ceil(self.batch_chunk);
-            let owner = |i: u32| {
-                // SAFETY: only `Plan` calls this, before any thread runs a stage.
-                batch_owner(unsafe {
-                    self.manifolds[(start + i * self.batch_chunk) as usize].get()
-                })
-            };
-            crew.stage(items, owner, |i| {
-                let first = start + i * self.batch_chunk;
-                let last = first.saturating_add(self.batch_chunk).min(end);
-                // SAFETY: the items of a stage are disjoint runs of one group's batches, whose
-                // points are disjoint too; the batches of a group write disjoint bodies.
-                let manifolds = unsafe { slice_mut(self.manifolds, first as usize..last as usize) };
-                let (Some(m0), Some(m1)) = (manifolds.first(), manifolds.last()) else {
-                    return;
-                };
-                let (p0, p1) = (m0.first, m1.first + m1.count);
-                // SAFETY: as above.
-                let points = unsafe { slice_mut(self.points, p0 as usize..p1 as usize) };
-                f(manifolds, points, p0);
-            });
-        }
+        each_batch_range(
+            crew,
+            self.manifolds,
+            self.points,
+            self.groups,
+            self.batch_chunk,
+            f,
+        );
     }
 
     /// One stage over the bodies (the static entry left out), each item `f(states, first)`
@@ -912,6 +996,41 @@ impl Substeps<'_> {
     }
 }
 
+/// One stage per group of batches ([`Batches::groups`]), each item `f(manifolds, points,
+/// base)` on a run of at most `chunk` of the group's batches, their points and the index of
+/// the first.
+fn each_batch_range(
+    crew: &impl Crew,
+    manifolds: &[Shared<ManifoldLanes>],
+    points: &[Shared<PointLanes>],
+    groups: &[u32],
+    chunk: u32,
+    f: impl Fn(&mut [ManifoldLanes], &mut [PointLanes], u32),
+) {
+    for group in groups.windows(2) {
+        let (start, end) = (group[0], group[1]);
+        let items = (end - start).div_ceil(chunk);
+        let owner = |i: u32| {
+            // SAFETY: only `Plan` calls this, before any thread runs a stage.
+            batch_owner(unsafe { manifolds[(start + i * chunk) as usize].get() })
+        };
+        crew.stage(items, owner, |i| {
+            let first = start + i * chunk;
+            let last = first.saturating_add(chunk).min(end);
+            // SAFETY: the items of a stage are disjoint runs of one group's batches, whose
+            // points are disjoint too; the batches of a group write disjoint bodies.
+            let manifolds = unsafe { slice_mut(manifolds, first as usize..last as usize) };
+            let (Some(m0), Some(m1)) = (manifolds.first(), manifolds.last()) else {
+                return;
+            };
+            let (p0, p1) = (m0.first, m1.first + m1.count);
+            // SAFETY: as above.
+            let points = unsafe { slice_mut(points, p0 as usize..p1 as usize) };
+            f(manifolds, points, p0);
+        });
+    }
+}
+
 /// The mechanical energy a body of step-start state `start` (world inertia `inertia`) may end
 /// the step with when only immovable bodies touched it: its kinetic energy at the start, with
 /// the step's applied forces' velocity change ([`SolverBody::force_velocity`]) added, plus
@@ -954,13 +1073,30 @@ impl Resolver for SoftStepResolver {
 
         let start = Stopwatch::start();
         self.load_bodies(bodies);
-        let any_restitution = self.prepare_contacts(bodies, contacts, h, ctx.gravity);
+        let params = self.arrange_contacts(bodies, contacts, h, ctx.gravity);
+        let any_restitution = self.batches.any_restitution;
         self.mark_contact_rows(bodies, contacts);
         self.mark_free();
         let exact_warm = self.mark_exact_warm();
-        if self.settings.block_relax && !self.settings.rigid_contacts {
-            solve::factor_blocks(&mut self.batches);
+        let threads = if self.batches.manifolds.len() >= PARALLEL_MIN_BATCHES {
+            team::available_threads()
+        } else {
+            1
+        };
+        let threads = if threads > 1 && self.choice.use_team() {
+            threads
+        } else {
+            1
+        };
+        if threads > 1 {
+            owner_bounds(
+                &self.batches.manifolds,
+                threads,
+                &mut self.owners,
+                &mut self.bounds,
+            );
         }
+        self.prepare_points(contacts, bodies, &params, threads);
         // Rigid contacts have their own push-out and no spring to size: no direct solve.
         let direct_rows = if self.settings.rigid_contacts {
             0
@@ -1010,26 +1146,8 @@ impl Resolver for SoftStepResolver {
             rate: self.settings.push_out_rate * inv_h,
             stored_separation: false,
         };
-        let threads = if self.batches.manifolds.len() >= PARALLEL_MIN_BATCHES {
-            team::available_threads()
-        } else {
-            1
-        };
-        let threads = if threads > 1 && self.choice.use_team() {
-            threads
-        } else {
-            1
-        };
         let substeps_start = Stopwatch::start();
         let direct_live = !self.direct.is_empty();
-        if threads > 1 {
-            owner_bounds(
-                &self.batches.manifolds,
-                threads,
-                &mut self.owners,
-                &mut self.bounds,
-            );
-        }
         let times = {
             let Batches {
                 manifolds,

@@ -277,9 +277,27 @@ pub fn prepare_batches(
     bodies: &[SolverBody],
     params: &PrepareParams,
 ) {
+    prepare_batch_range(manifolds, points, 0, sources, contacts, bodies, params);
+}
+
+/// [`prepare_batches`] for a run of the batches: `points` holds their points, the first
+/// being point `base` of all batches (`sources` and each batch's
+/// [`ManifoldLanes::first`] count from the first point of all). Each batch is prepared on
+/// its own, so runs may be prepared in any order, or at once on several threads, with the
+/// same result.
+pub fn prepare_batch_range(
+    manifolds: &mut [ManifoldLanes],
+    points: &mut [PointLanes],
+    base: u32,
+    sources: &[[u32; LANES]],
+    contacts: &[Contact],
+    bodies: &[SolverBody],
+    params: &PrepareParams,
+) {
     with_best_lanes!(prepare_batches_impl(
         manifolds,
         points,
+        base: u32,
         sources: &[[u32; LANES]],
         contacts: &[Contact],
         bodies: &[SolverBody],
@@ -291,6 +309,7 @@ pub fn prepare_batches(
 fn prepare_batches_impl<F: Lane>(
     manifolds: &mut [ManifoldLanes<F>],
     points: &mut [PointLanes<F>],
+    base: u32,
     sources: &[[u32; LANES]],
     contacts: &[Contact],
     bodies: &[SolverBody],
@@ -304,7 +323,8 @@ fn prepare_batches_impl<F: Lane>(
         let differs = |v: V3x8<F>| (0..WIDTH).any(|l| v.x[l] != v.y[l] || v.y[l] != v.z[l]);
         m.locked = differs(a.inv_mass_axes) || differs(b.inv_mass_axes);
         let range = m.first as usize..(m.first + m.count) as usize;
-        for (out, source) in points[range.clone()].iter_mut().zip(&sources[range]) {
+        let local = (m.first - base) as usize..(m.first - base + m.count) as usize;
+        for (out, source) in points[local].iter_mut().zip(&sources[range]) {
             let lane_contacts = source.map(|i| (i != NO_SOURCE).then(|| &contacts[i as usize]));
             prepare_point(out, lane_contacts, &a, &b, params);
         }
@@ -341,6 +361,7 @@ mod tests {
         prepare_batches_impl::<F8>(
             &mut manifolds,
             &mut points,
+            0,
             &batches.sources,
             &scene.contacts,
             &scene.bodies,

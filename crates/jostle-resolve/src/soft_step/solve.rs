@@ -814,13 +814,24 @@ pub fn factor_blocks(batches: &mut Batches) {
     let Batches {
         manifolds, points, ..
     } = batches;
-    with_best_lanes!(factor_blocks_impl(manifolds, points) -> ())
+    factor_block_range(manifolds, points, 0);
+}
+
+/// [`factor_blocks`] for a run of the batches whose points are `points`, the first being
+/// point `base` of all batches. Each batch is factored on its own, so runs may be factored in
+/// any order, or at once on several threads, with the same result.
+pub fn factor_block_range(manifolds: &mut [ManifoldLanes], points: &mut [PointLanes], base: u32) {
+    with_best_lanes!(factor_blocks_impl(manifolds, points, base: u32) -> ())
 }
 
 #[inline(always)]
-fn factor_blocks_impl<F: Lane>(manifolds: &mut [ManifoldLanes<F>], points: &mut [PointLanes<F>]) {
+fn factor_blocks_impl<F: Lane>(
+    manifolds: &mut [ManifoldLanes<F>],
+    points: &mut [PointLanes<F>],
+    base: u32,
+) {
     for m in manifolds.iter_mut().filter(|m| !m.side) {
-        let first = m.first as usize;
+        let first = (m.first - base) as usize;
         let pts = &points[first..first + m.count as usize];
         m.block = factor_block::<F>(m, pts);
     }
