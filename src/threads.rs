@@ -59,7 +59,7 @@ impl Runner for TeamRunner {
         let mut team = self.team.lock().unwrap_or_else(|e| e.into_inner());
         team.reset(threads, &[parts]);
         team::run(&team, |member| {
-            member.stage(items, |i| i, |i| f(i as usize));
+            member.stage(items, |i| f(i as usize));
         });
     }
 }

@@ -192,9 +192,6 @@ pub struct SoftStepResolver {
     /// The threads of the substeps ([`team`]) and the stages they run.
     team: Team,
     plan: Vec<team::Parts>,
-    /// Scratch of [`owner_bounds`], and its result.
-    owners: Vec<u32>,
-    bounds: Vec<u32>,
     /// Whether the team or one thread runs the substeps faster here ([`ThreadChoice`]).
     choice: ThreadChoice,
 }
@@ -619,7 +616,7 @@ impl SoftStepResolver {
             factor,
         };
         let plan = Plan {
-            bounds: &self.bounds,
+            threads,
             stages: Default::default(),
         };
         work.run(&plan);
@@ -776,36 +773,6 @@ impl Timing {
     }
 }
 
-/// The body whose thread should solve batch `m` ([`team::Plan`]): its first manifold's
-/// lower movable body. [`Batches::pack`] orders each colour's manifolds by it.
-fn batch_owner(m: &ManifoldLanes) -> u32 {
-    match (m.a[0], m.b[0]) {
-        (STATIC_BODY, b) => b,
-        (a, STATIC_BODY) => a,
-        (a, b) => a.min(b),
-    }
-}
-
-/// The first body of each thread's range but the first's, for `threads` threads: the
-/// owners ([`batch_owner`]) that split the batches into equal shares.
-fn owner_bounds(
-    manifolds: &[ManifoldLanes],
-    threads: usize,
-    scratch: &mut Vec<u32>,
-    bounds: &mut Vec<u32>,
-) {
-    scratch.clear();
-    scratch.extend(manifolds.iter().map(batch_owner));
-    scratch.sort_unstable();
-    bounds.clear();
-    bounds.extend((1..threads).map(|t| {
-        scratch
-            .get(scratch.len() * t / threads)
-            .copied()
-            .unwrap_or(u32::MAX)
-    }));
-}
-
 /// Everything the substeps of one step read and write, shared by the threads that run them
 /// ([`team`]); every access to a shared element follows the contract of [`shared`]: within a
 /// stage, items write disjoint batches and bodies.
@@ -959,17 +926,13 @@ impl Substeps<'_> {
         let start = (STATIC_BODY as usize + 1).min(self.states.len()) as u32;
         let end = self.states.len() as u32;
         let items = (end - start).div_ceil(self.body_chunk);
-        crew.stage(
-            items,
-            |i| start + i * self.body_chunk,
-            |i| {
-                let first = start + i * self.body_chunk;
-                let last = first.saturating_add(self.body_chunk).min(end);
-                // SAFETY: the items of a stage are disjoint runs of bodies.
-                let states = unsafe { slice_mut(self.states, first as usize..last as usize) };
-                f(states, first as usize);
-            },
-        );
+        crew.stage(items, |i| {
+            let first = start + i * self.body_chunk;
+            let last = first.saturating_add(self.body_chunk).min(end);
+            // SAFETY: the items of a stage are disjoint runs of bodies.
+            let states = unsafe { slice_mut(self.states, first as usize..last as usize) };
+            f(states, first as usize);
+        });
     }
 
     /// The direct solve ([`direct`]) after a pass, as a stage of one item.
@@ -977,22 +940,18 @@ impl Substeps<'_> {
         if !self.direct_live {
             return;
         }
-        crew.stage(
-            1,
-            |_| 0,
-            |_| {
-                // SAFETY: a stage of one item: no other thread touches anything meanwhile.
-                let (direct, manifolds, points, states) = unsafe {
-                    (
-                        self.direct.get_mut(),
-                        slice_mut(self.manifolds, 0..self.manifolds.len()),
-                        slice_mut(self.points, 0..self.points.len()),
-                        slice_mut(self.states, 0..self.states.len()),
-                    )
-                };
-                direct.correct(manifolds, points, states, pass);
-            },
-        );
+        crew.stage(1, |_| {
+            // SAFETY: a stage of one item: no other thread touches anything meanwhile.
+            let (direct, manifolds, points, states) = unsafe {
+                (
+                    self.direct.get_mut(),
+                    slice_mut(self.manifolds, 0..self.manifolds.len()),
+                    slice_mut(self.points, 0..self.points.len()),
+                    slice_mut(self.states, 0..self.states.len()),
+                )
+            };
+            direct.correct(manifolds, points, states, pass);
+        });
     }
 }
 
@@ -1010,11 +969,7 @@ fn each_batch_range(
     for group in groups.windows(2) {
         let (start, end) = (group[0], group[1]);
         let items = (end - start).div_ceil(chunk);
-        let owner = |i: u32| {
-            // SAFETY: only `Plan` calls this, before any thread runs a stage.
-            batch_owner(unsafe { manifolds[(start + i * chunk) as usize].get() })
-        };
-        crew.stage(items, owner, |i| {
+        crew.stage(items, |i| {
             let first = start + i * chunk;
             let last = first.saturating_add(chunk).min(end);
             // SAFETY: the items of a stage are disjoint runs of one group's batches, whose
@@ -1088,14 +1043,6 @@ impl Resolver for SoftStepResolver {
         } else {
             1
         };
-        if threads > 1 {
-            owner_bounds(
-                &self.batches.manifolds,
-                threads,
-                &mut self.owners,
-                &mut self.bounds,
-            );
-        }
         self.prepare_points(contacts, bodies, &params, threads);
         // Rigid contacts have their own push-out and no spring to size: no direct solve.
         let direct_rows = if self.settings.rigid_contacts {
@@ -1190,7 +1137,7 @@ impl Resolver for SoftStepResolver {
             };
             if threads > 1 {
                 let plan = Plan {
-                    bounds: &self.bounds,
+                    threads,
                     stages: Default::default(),
                 };
                 work.run(&plan, &Timing::default());

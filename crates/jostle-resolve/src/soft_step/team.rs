@@ -7,9 +7,10 @@
 //! colour, or a run of bodies) that write disjoint data, so they may run in any order and on
 //! any thread with the same result, bit for bit; a stage starts only when the one before has
 //! finished. Every thread of the team runs the same sequence ([`Crew::stage`]):
-//! - each stage's items are split into one contiguous part per thread by the bodies they
-//!   write ([`Plan`]), so a body is handled by the same thread from stage to stage and its
-//!   state, and each batch's points, stay in that thread's core's cache;
+//! - each stage's items are split into one contiguous part per thread, of equal counts
+//!   ([`Plan`]); the soft step orders each colour's batches by the bodies they write, so a
+//!   thread's part of every colour touches about the same bodies, and their states stay in
+//!   its core's cache;
 //! - items are claimed through an atomic counter per part; a thread runs its own part, then
 //!   the parts of threads that have not reached the stage yet, and then waits only for items
 //!   that a running thread has claimed. A thread that starts late, or never, holds nothing
@@ -40,42 +41,35 @@ pub const MAX_THREADS: usize = 8;
 pub trait Crew {
     /// Runs `f(i)` for every item `i` in `0..items`, each once, in any order and on any
     /// thread of the crew, and returns when all have finished (their writes visible to this
-    /// thread). Every thread of a crew makes the same calls in the same order. `owner(i)` is
-    /// the body whose thread should run item `i` ([`Plan`]), non-decreasing in `i`.
-    fn stage(&self, items: u32, owner: impl Fn(u32) -> u32, f: impl FnMut(u32));
+    /// thread). Every thread of a crew makes the same calls in the same order.
+    fn stage(&self, items: u32, f: impl FnMut(u32));
 }
 
 /// Where each thread's part of a stage's items starts; entry `threads` is the item count.
 pub type Parts = [u32; MAX_THREADS + 1];
 
-/// Records each stage's parts and runs nothing: thread t's part is the items whose owner
-/// body is at least `bounds[t - 1]` and below `bounds[t]`. A body is thus handled by the
-/// same thread in every stage (except where an item holds bodies of two threads), and its
-/// state stays in that thread's core's cache.
+/// Records each stage's parts and runs nothing: thread t of `threads` gets the items from
+/// t·items/threads on. Split by count, every stage is shared evenly; split instead where the
+/// bodies the items write cross fixed bounds (one range of bodies per thread, the same in
+/// every stage), a colour's batches were shared unevenly and the stage waited for the
+/// thread with more (the 3D pyramid of 10 layers on a team of two: the larger parts summed
+/// over a step's stages were 1,887 items where even shares give 1,581, and its resolve stage
+/// took 1.25 ms against 1.19 split by count; benches/RESULTS.md, "The batches prepared by the
+/// threads that solve them").
 #[derive(Debug, Default)]
-pub struct Plan<'a> {
-    /// The first body of each thread's range but the first's.
-    pub bounds: &'a [u32],
+pub struct Plan {
+    /// Threads of the team (1 to [`MAX_THREADS`]).
+    pub threads: usize,
     /// The parts of each stage, in order.
     pub stages: RefCell<Vec<Parts>>,
 }
 
-impl Crew for Plan<'_> {
-    fn stage(&self, items: u32, owner: impl Fn(u32) -> u32, _f: impl FnMut(u32)) {
+impl Crew for Plan {
+    fn stage(&self, items: u32, _f: impl FnMut(u32)) {
+        let threads = self.threads.clamp(1, MAX_THREADS) as u64;
         let mut parts = [items; MAX_THREADS + 1];
-        parts[0] = 0;
-        for (t, &bound) in self.bounds.iter().enumerate().take(MAX_THREADS - 1) {
-            // The first item owned by a body at or past the bound (owners never decrease).
-            let (mut lo, mut hi) = (parts[t], items);
-            while lo < hi {
-                let mid = lo + (hi - lo) / 2;
-                if owner(mid) < bound {
-                    lo = mid + 1;
-                } else {
-                    hi = mid;
-                }
-            }
-            parts[t + 1] = lo;
+        for (t, part) in parts.iter_mut().enumerate().take(threads as usize) {
+            *part = (t as u64 * u64::from(items) / threads) as u32;
         }
         self.stages.borrow_mut().push(parts);
     }
@@ -87,7 +81,7 @@ pub struct Solo;
 
 impl Crew for Solo {
     #[inline]
-    fn stage(&self, items: u32, _owner: impl Fn(u32) -> u32, mut f: impl FnMut(u32)) {
+    fn stage(&self, items: u32, mut f: impl FnMut(u32)) {
         for i in 0..items {
             f(i);
         }
@@ -124,7 +118,7 @@ pub struct Team {
 
 impl Team {
     /// Prepares the team of `threads` (1 to [`MAX_THREADS`]) for the stages of `plan`
-    /// (each stage's parts, in order, as [`Plan`] records them for `threads` − 1 bounds).
+    /// (each stage's parts, in order, as [`Plan`] records them for `threads`).
     pub fn reset(&mut self, threads: usize, plan: &[Parts]) {
         debug_assert!((1..=MAX_THREADS).contains(&threads));
         self.threads = threads.clamp(1, MAX_THREADS);
@@ -208,7 +202,7 @@ impl Member<'_> {
 }
 
 impl Crew for Member<'_> {
-    fn stage(&self, items: u32, _owner: impl Fn(u32) -> u32, mut f: impl FnMut(u32)) {
+    fn stage(&self, items: u32, mut f: impl FnMut(u32)) {
         let k = self.stage.get();
         self.stage.set(k + 1);
         let team = self.team;
@@ -538,27 +532,22 @@ mod tests {
     use super::*;
     use std::sync::atomic::{AtomicBool, AtomicU64};
 
-    /// The stages of the test: item counts, each item owned by body `item` (so the parts
-    /// follow `bounds`).
-    fn plan(counts: &[u32], bounds: &[u32]) -> Vec<Parts> {
+    /// The stages of the test for `threads`: item counts.
+    fn plan(counts: &[u32], threads: usize) -> Vec<Parts> {
         let plan = Plan {
-            bounds,
+            threads,
             stages: RefCell::default(),
         };
         for &items in counts {
-            plan.stage(items, |i| i, |_| {});
+            plan.stage(items, |_| {});
         }
         plan.stages.into_inner()
     }
 
-    /// A team of `threads` for stages of `counts` items, whose owners 0..`owners` are split
-    /// evenly among the threads.
-    fn team(threads: usize, counts: &[u32], owners: u32) -> Team {
-        let bounds: Vec<u32> = (1..threads as u32)
-            .map(|t| t * owners / threads as u32)
-            .collect();
+    /// A team of `threads` for stages of `counts` items.
+    fn team(threads: usize, counts: &[u32]) -> Team {
         let mut team = Team::default();
-        team.reset(threads, &plan(counts, &bounds));
+        team.reset(threads, &plan(counts, threads));
         team
     }
 
@@ -569,22 +558,18 @@ mod tests {
     fn every_item_runs_once_after_the_stage_before() {
         let counts: Vec<u32> = (0..200).map(|k| (k * 7) % 23).collect();
         for threads in 1..=4 {
-            let team = team(threads, &counts, 23);
+            let team = team(threads, &counts);
             let total: Vec<AtomicU64> = (0..counts.len()).map(|_| AtomicU64::new(0)).collect();
             let early = AtomicBool::new(false);
             let sum = |n: u32| u64::from(n) * u64::from(n + 1) / 2;
             run(&team, |m| {
                 for (k, &items) in counts.iter().enumerate() {
-                    m.stage(
-                        items,
-                        |i| i,
-                        |i| {
-                            if k > 0 && total[k - 1].load(Ordering::Relaxed) != sum(counts[k - 1]) {
-                                early.store(true, Ordering::Relaxed);
-                            }
-                            total[k].fetch_add(u64::from(i) + 1, Ordering::Relaxed);
-                        },
-                    );
+                    m.stage(items, |i| {
+                        if k > 0 && total[k - 1].load(Ordering::Relaxed) != sum(counts[k - 1]) {
+                            early.store(true, Ordering::Relaxed);
+                        }
+                        total[k].fetch_add(u64::from(i) + 1, Ordering::Relaxed);
+                    });
                 }
             });
             assert!(
@@ -607,17 +592,13 @@ mod tests {
     fn a_panicking_item_poisons_the_team() {
         let counts = [64u32; 20];
         for threads in 1..=3 {
-            let team = team(threads, &counts, 64);
+            let team = team(threads, &counts);
             let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 run(&team, |m| {
                     for (k, &items) in counts.iter().enumerate() {
-                        m.stage(
-                            items,
-                            |i| i,
-                            |i| {
-                                assert!(!(k == 7 && i == 50), "item 50 of stage 7");
-                            },
-                        );
+                        m.stage(items, |i| {
+                            assert!(!(k == 7 && i == 50), "item 50 of stage 7");
+                        });
                     }
                 });
             }));
@@ -625,13 +606,14 @@ mod tests {
         }
     }
 
-    /// Each thread's part holds the items whose owner lies in its range of bodies.
+    /// Each thread's part is an equal share of the stage's items (to one item), in order.
     #[test]
-    fn parts_follow_the_owners() {
-        let parts = plan(&[10, 0, 3], &[4, 8]);
-        assert_eq!(&parts[0][..3], &[0, 4, 8]);
+    fn parts_share_each_stage_evenly() {
+        let parts = plan(&[10, 0, 3], 3);
+        assert_eq!(&parts[0][..3], &[0, 3, 6]);
         assert!(parts[0][3..].iter().all(|&p| p == 10));
         assert!(parts[1].iter().all(|&p| p == 0));
-        assert_eq!(&parts[2][..3], &[0, 3, 3]);
+        assert_eq!(&parts[2][..3], &[0, 1, 2]);
+        assert!(parts[2][3..].iter().all(|&p| p == 3));
     }
 }
