@@ -253,8 +253,8 @@ impl Batches {
     /// lies within 60° of horizontal. When all of these are as at the last packing (a
     /// resting pile: the same pairs step after step) the batches keep that layout and only
     /// their contents are prepared again: the same result as packing afresh, without the
-    /// colouring and sorting. A caller that edits `manifolds`, `sources` or `groups` by
-    /// hand between two packings must call [`Batches::forget_layout`].
+    /// colouring and sorting. A caller that edits `manifolds`, `sources`, `groups` or
+    /// `points` by hand between two packings must call [`Batches::forget_layout`].
     pub fn pack(
         &mut self,
         contacts: &[Contact],
@@ -343,7 +343,7 @@ impl Batches {
     /// `colours` and `overflow`. `bodies`: how many bodies there are.
     fn lay_out(&mut self, contacts: &[Contact], bodies: usize) {
         self.manifolds.clear();
-        // `points` keeps its length from the last step: every point is overwritten by the
+        // `points` is resized below, not cleared: every point is overwritten by the
         // preparation, so only a growth needs filling (a step's 1.5 kB per point is otherwise
         // written twice).
         self.sources.clear();

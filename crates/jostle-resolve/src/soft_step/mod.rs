@@ -26,9 +26,9 @@
 //!    [`direct`] are solved exactly ([`direct::DirectIslands::correct`]), where Gauss-Seidel
 //!    would need about as many sweeps as their mass ratio, or passes a column's load and lean
 //!    on one joint per sweep. With [`PARALLEL_MIN_BATCHES`]
-//!    batches or more the substeps may run on a team of threads, with the same result bit
-//!    for bit ([`team`]), whenever the team has measured faster than one thread
-//!    (`ThreadChoice`).
+//!    batches or more the preparation of the batches' points and the substeps may run on a
+//!    team of threads, with the same result bit for bit ([`team`]), whenever the team's
+//!    substeps have measured faster than one thread's (`ThreadChoice`).
 //! 3. restitution, skipped when no contact bounces: Newton's law at every point that approached
 //!    faster than the threshold, swept to convergence with the rest of the contacts, through
 //!    each body's inertia as it has turned since the start of the step
@@ -149,8 +149,10 @@ use std::time::Duration;
 use team::{Crew, Plan, Solo, Team};
 
 /// The soft-step resolver (see the module docs). Holds its settings and scratch buffers
-/// reused from step to step; its only memory between steps is the contacts' impulses, which
-/// the caller carries, so swapping resolvers mid-simulation is safe.
+/// reused from step to step; its only memory between steps that changes a result is the
+/// contacts' impulses, which the caller carries, so swapping resolvers mid-simulation is
+/// safe (it also keeps the batches' layout while the contacts stay the same, which a fresh
+/// packing would give again: [`Batches::arrange`]).
 #[derive(Clone, Debug, Default)]
 pub struct SoftStepResolver {
     /// The settings used by the next step; change them freely between steps.
@@ -203,7 +205,8 @@ const PROBE_INTERVAL: u32 = 32;
 const COST_WEIGHT: f64 = 0.25;
 
 /// Which runs a large step's substeps faster on this machine: the team of threads or the
-/// calling thread alone. Both give the same results bit for bit (`tests/threads.rs` of the
+/// calling thread alone (the choice takes the step's preparation of the points with it,
+/// [`SoftStepResolver::prepare_points`]; its clock measures the substeps). Both give the same results bit for bit (`tests/threads.rs` of the
 /// `jostle` crate), so the choice is free to follow the clock: each mode's cost per contact
 /// point is a running average of its measured substep time, the cheaper one runs, and every
 /// [`PROBE_INTERVAL`] steps the other runs once to keep its figure current (the first run of

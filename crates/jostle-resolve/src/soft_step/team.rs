@@ -1,7 +1,7 @@
-//! Several threads through the substeps of one soft step, with results independent of how
-//! many take part.
+//! Several threads through the substeps of one soft step (and through the preparation of its
+//! batches before them), with results independent of how many take part.
 //!
-//! A step's substeps are a fixed sequence of *stages*: integrate the velocities, warm start
+//! A step's substeps are a fixed sequence of *stages* (its preparation one stage per colour): integrate the velocities, warm start
 //! colour by colour, the biased pass colour by colour, the direct solve, integrate the
 //! positions, relax colour by colour. A stage is a number of *items* (a few batches of one
 //! colour, or a run of bodies) that write disjoint data, so they may run in any order and on
@@ -49,7 +49,8 @@ pub trait Crew {
 pub type Parts = [u32; MAX_THREADS + 1];
 
 /// Records each stage's parts and runs nothing: thread t of `threads` gets the items from
-/// t·items/threads on. Split by count, every stage is shared evenly; split instead where the
+/// ⌈t·items/threads⌉ on (the first threads take the larger shares, so a stage of one item,
+/// the direct solve, is the calling thread's). Split by count, every stage is shared evenly; split instead where the
 /// bodies the items write cross fixed bounds (one range of bodies per thread, the same in
 /// every stage), a colour's batches were shared unevenly and the stage waited for the
 /// thread with more (the 3D pyramid of 10 layers on a team of two: the larger parts summed
@@ -69,7 +70,7 @@ impl Crew for Plan {
         let threads = self.threads.clamp(1, MAX_THREADS) as u64;
         let mut parts = [items; MAX_THREADS + 1];
         for (t, part) in parts.iter_mut().enumerate().take(threads as usize) {
-            *part = (t as u64 * u64::from(items) / threads) as u32;
+            *part = (t as u64 * u64::from(items)).div_ceil(threads) as u32;
         }
         self.stages.borrow_mut().push(parts);
     }
@@ -609,11 +610,13 @@ mod tests {
     /// Each thread's part is an equal share of the stage's items (to one item), in order.
     #[test]
     fn parts_share_each_stage_evenly() {
-        let parts = plan(&[10, 0, 3], 3);
-        assert_eq!(&parts[0][..3], &[0, 3, 6]);
+        let parts = plan(&[10, 0, 3, 1], 3);
+        assert_eq!(&parts[0][..3], &[0, 4, 7]);
         assert!(parts[0][3..].iter().all(|&p| p == 10));
         assert!(parts[1].iter().all(|&p| p == 0));
         assert_eq!(&parts[2][..3], &[0, 1, 2]);
         assert!(parts[2][3..].iter().all(|&p| p == 3));
+        // One item: the calling thread's (thread 0).
+        assert_eq!(&parts[3][..2], &[0, 1]);
     }
 }
