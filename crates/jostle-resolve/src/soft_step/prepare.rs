@@ -386,6 +386,63 @@ mod tests {
         super::super::lanes_avx::CAP.store(0, std::sync::atomic::Ordering::Relaxed);
     }
 
+    /// Prepared (and factored) a run of batches at a time, as the team's threads do, the
+    /// batches come out exactly as prepared all at once.
+    #[test]
+    fn runs_of_batches_are_prepared_as_all_at_once() {
+        let scene = synthetic::random_pile(2000, 12);
+        let params = PrepareParams {
+            static_softness: Softness::new(120.0, 7.0, synthetic::DT / 8.0),
+            dynamic_softness: Softness::new(60.0, 7.0, synthetic::DT / 8.0),
+            warm_scale: 0.125,
+            preload_ramp: 2000.0,
+            preload_bound: 1.0,
+            step: synthetic::DT,
+            down: Vec3::NEG_Y,
+        };
+        let mut whole = Batches::default();
+        whole.pack(&scene.contacts, &scene.bodies, 0.02, &params);
+        crate::soft_step::solve::factor_blocks(&mut whole);
+        let mut runs = Batches::default();
+        runs.arrange(&scene.contacts, &scene.bodies, 0.02, &params);
+        assert!(runs.manifolds.len() > 10);
+        let Batches {
+            manifolds,
+            points,
+            sources,
+            ..
+        } = &mut runs;
+        let mut rest = &mut manifolds[..];
+        // Runs of 1, 2, 3, ... batches, each with its own points.
+        for len in 1.. {
+            if rest.is_empty() {
+                break;
+            }
+            let (run, after) = rest.split_at_mut(len.min(rest.len()));
+            let (p0, p1) = (
+                run[0].first,
+                run[run.len() - 1].first + run[run.len() - 1].count,
+            );
+            let pts = &mut points[p0 as usize..p1 as usize];
+            prepare_batch_range(
+                run,
+                pts,
+                p0,
+                sources,
+                &scene.contacts,
+                &scene.bodies,
+                &params,
+            );
+            crate::soft_step::solve::factor_block_range(run, pts, p0);
+            rest = after;
+        }
+        assert_eq!(format!("{:?}", runs.points), format!("{:?}", whole.points));
+        assert_eq!(
+            format!("{:?}", runs.manifolds),
+            format!("{:?}", whole.manifolds)
+        );
+    }
+
     /// The lane-wise basis is `contact_basis`, bit for bit, for normals on both sides of the
     /// |n.x| = 0.6 switch; padding lanes get zero tangents.
     #[test]
