@@ -199,23 +199,39 @@ pub struct Batches {
     order: Vec<u32>,
     /// Each run's place within its colour (`Batches::pack`).
     keys: Vec<u128>,
-    /// Input indices of the contacts that take part, in input order.
-    kept: Vec<u32>,
-    /// What the layout of the last full packing was decided from, one entry per contact
-    /// that took part ([`Batches::pack`]): its input index, its bodies and its flags
-    /// ([`layout_flags`]).
-    layout: Vec<[u32; 4]>,
+    /// The contacts that take part, in input order, with what the layout depends on
+    /// ([`Batches::pack`]); the layout's input when it was last decided.
+    layout: Vec<Kept>,
     /// `manifolds`, `sources` and `groups` lengths that the last full packing left, or
     /// `None` before the first one: a layout is reused only if they are unchanged.
     layout_lengths: Option<[usize; 3]>,
 }
 
-/// The flags of a contact that [`Batches::pack`]'s layout depends on besides its index and
-/// bodies: bit 0 whether its normal lies within 60° of horizontal under gravity, bit 1
-/// whether it has friction.
-fn layout_flags(c: &Contact, down: Vec3) -> u32 {
-    let side = down != Vec3::ZERO && c.normal.dot(down).abs() < SIDE_COSINE;
-    u32::from(side) | (u32::from(c.friction > 0.0) << 1)
+/// A contact that takes part in the step, as [`Batches::pack`]'s layout sees it: everything
+/// the layout depends on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Kept {
+    /// Its index in the step's contacts.
+    index: u32,
+    /// Its bodies.
+    a: u32,
+    b: u32,
+    /// Whether its normal lies within 60° of horizontal under gravity (`down`).
+    side: bool,
+    /// Whether it has friction.
+    friction: bool,
+}
+
+impl Kept {
+    fn new(index: usize, c: &Contact, down: Vec3) -> Self {
+        Self {
+            index: index as u32,
+            a: c.a,
+            b: c.b,
+            side: down != Vec3::ZERO && c.normal.dot(down).abs() < SIDE_COSINE,
+            friction: c.friction > 0.0,
+        }
+    }
 }
 
 /// How fast the bodies of `c` close its gap at its points (m/s; 0 when they do not): the
@@ -301,7 +317,7 @@ impl Batches {
                     "contact normal must be unit, got {}",
                     c.normal
                 );
-                let entry = [i as u32, c.a, c.b, layout_flags(c, params.down)];
+                let entry = Kept::new(i, c, params.down);
                 match self.layout.get_mut(kept) {
                     Some(old) => {
                         same &= *old == entry;
@@ -327,7 +343,7 @@ impl Batches {
                 (m.exact_a, m.exact_b) = (0, 0);
             }
         } else {
-            self.lay_out(contacts, bodies.len());
+            self.lay_out(bodies.len());
             self.layout_lengths =
                 Some([self.manifolds.len(), self.sources.len(), self.groups.len()]);
         }
@@ -341,15 +357,13 @@ impl Batches {
     /// Colours the manifolds of the contacts in `layout` and packs them into batches:
     /// `manifolds` (their bodies and points, not yet prepared), `sources`, `groups`,
     /// `colours` and `overflow`. `bodies`: how many bodies there are.
-    fn lay_out(&mut self, contacts: &[Contact], bodies: usize) {
+    fn lay_out(&mut self, bodies: usize) {
         self.manifolds.clear();
         // `points` is resized below, not cleared: every point is overwritten by the
         // preparation, so only a growth needs filling (a step's 1.5 kB per point is otherwise
         // written twice).
         self.sources.clear();
         self.runs.clear();
-        self.kept.clear();
-        self.kept.extend(self.layout.iter().map(|e| e[0]));
         self.colour_mask.clear();
         self.colour_mask.resize(bodies, 0);
         self.colours = 0;
@@ -358,13 +372,12 @@ impl Batches {
         // Manifolds: runs of the same body pair, coloured by the colour masks: first all with
         // colours 0..64, then again those left with colours 64..128 and fresh masks, and so on.
         let mut start = 0;
-        let kept = &self.kept;
+        let kept = &self.layout;
         while start < kept.len() {
-            let first = &contacts[kept[start] as usize];
-            let (a, b) = (first.a, first.b);
+            let (a, b) = (kept[start].a, kept[start].b);
             let mut len = 1;
             while start + len < kept.len() && len < MAX_POINTS && {
-                let c = &contacts[kept[start + len] as usize];
+                let c = &kept[start + len];
                 c.a == a && c.b == b
             } {
                 len += 1;
@@ -407,7 +420,7 @@ impl Batches {
             self.colour_mask.fill(0);
             let base = round * ROUND_COLOURS;
             for r in self.runs.iter_mut().filter(|r| r.colour == COLOURS) {
-                let c = &contacts[kept[r.start as usize] as usize];
+                let c = &kept[r.start as usize];
                 let mask = |i: u32| {
                     if i == STATIC_BODY {
                         0
@@ -461,13 +474,13 @@ impl Batches {
         // beyond deciding which batches are side batches the order changes no result.
         self.keys.clear();
         self.keys.extend(self.runs.iter().map(|r| {
-            let c = &contacts[kept[r.start as usize] as usize];
+            let c = &kept[r.start as usize];
             let body = match (c.a, c.b) {
                 (STATIC_BODY, b) => b,
                 (a, STATIC_BODY) => a,
                 (a, b) => a.min(b),
             };
-            let side = self.layout[r.start as usize][3] & 1 != 0;
+            let side = c.side;
             (u128::from(body / SIDE_BLOCK) << 96)
                 | (u128::from(!side) << 64)
                 | (u128::from(body) << 32)
@@ -506,7 +519,7 @@ impl Batches {
             }
             // Near horizontal: the key's bit 64 (`!side`) is clear.
             let side = (0..lanes).all(|l| self.keys[self.order[k + l] as usize] & (1 << 64) == 0);
-            self.push_batch(&batch_runs[..lanes], contacts, side);
+            self.push_batch(&batch_runs[..lanes], side);
             k += lanes;
         }
         self.groups.push(self.manifolds.len() as u32);
@@ -517,14 +530,14 @@ impl Batches {
     /// Appends one batch holding `runs` (at most [`LANES`]) in lanes 0, 1, ...: its bodies,
     /// its points' sources; [`prepare_batches`] then writes the points.
     /// `side`: every run's normal lies within 60° of horizontal ([`ManifoldLanes::side`]).
-    fn push_batch(&mut self, runs: &[Run], contacts: &[Contact], side: bool) {
+    fn push_batch(&mut self, runs: &[Run], side: bool) {
         debug_assert!(!runs.is_empty() && runs.len() <= LANES);
         let count = runs.iter().map(|r| r.len).max().unwrap_or(0);
         let first = self.sources.len() as u32;
         let mut a = [STATIC_BODY; LANES];
         let mut b = [STATIC_BODY; LANES];
         for (lane, r) in runs.iter().enumerate() {
-            let c0 = &contacts[self.kept[r.start as usize] as usize];
+            let c0 = &self.layout[r.start as usize];
             (a[lane], b[lane]) = (c0.a, c0.b);
         }
         let mut friction = false;
@@ -532,9 +545,9 @@ impl Batches {
             let mut source = [NO_SOURCE; LANES];
             for (lane, r) in runs.iter().enumerate() {
                 if p < r.len {
-                    let i = self.kept[(r.start + p) as usize];
-                    source[lane] = i;
-                    friction |= contacts[i as usize].friction > 0.0;
+                    let c = &self.layout[(r.start + p) as usize];
+                    source[lane] = c.index;
+                    friction |= c.friction;
                 }
             }
             self.sources.push(source);

@@ -206,8 +206,9 @@ const COST_WEIGHT: f64 = 0.25;
 
 /// Which runs a large step's substeps faster on this machine: the team of threads or the
 /// calling thread alone (the choice takes the step's preparation of the points with it,
-/// [`SoftStepResolver::prepare_points`]; its clock measures the substeps). Both give the same results bit for bit (`tests/threads.rs` of the
-/// `jostle` crate), so the choice is free to follow the clock: each mode's cost per contact
+/// [`SoftStepResolver::prepare_points`]; its clock measures the substeps). Both give the
+/// same results bit for bit (`tests/threads.rs` of the `jostle` crate), so the choice is
+/// free to follow the clock: each mode's cost per contact
 /// point is a running average of its measured substep time, the cheaper one runs, and every
 /// [`PROBE_INTERVAL`] steps the other runs once to keep its figure current (the first run of
 /// each is not counted: it starts the helper threads or warms the caches). Measured why: on

@@ -1,9 +1,9 @@
 //! Several threads through the substeps of one soft step (and through the preparation of its
 //! batches before them), with results independent of how many take part.
 //!
-//! A step's substeps are a fixed sequence of *stages* (its preparation one stage per colour): integrate the velocities, warm start
-//! colour by colour, the biased pass colour by colour, the direct solve, integrate the
-//! positions, relax colour by colour. A stage is a number of *items* (a few batches of one
+//! A step's substeps are a fixed sequence of *stages* (its preparation is one stage per
+//! colour): integrate the velocities, warm start colour by colour, the biased pass colour by
+//! colour, the direct solve, integrate the positions, relax colour by colour. A stage is a number of *items* (a few batches of one
 //! colour, or a run of bodies) that write disjoint data, so they may run in any order and on
 //! any thread with the same result, bit for bit; a stage starts only when the one before has
 //! finished. Every thread of the team runs the same sequence ([`Crew::stage`]):
