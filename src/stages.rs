@@ -603,8 +603,9 @@ fn rewound_velocity(v: Vec3, a: Vec3, moved: Vec3, dropped: f32) -> Vec3 {
     rest * (budget.max(0.0) / rest.length_squared().max(f32::MIN_POSITIVE)).sqrt()
 }
 
-/// Copies poses and velocities back into the bodies, the contacts' impulses back into the
-/// narrow phase, and quarantines bodies whose new state is not finite.
+/// Copies poses and velocities back into the bodies, the contacts' impulses and preloads back
+/// into the narrow phase's contact list (its persistent points take them at its next update),
+/// and quarantines bodies whose new state is not finite.
 pub(crate) fn scatter(
     bodies: &mut BodySet,
     narrow: &mut NarrowPhase,

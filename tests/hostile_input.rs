@@ -224,6 +224,16 @@ fn a_snapshot_names_the_body_or_collider_and_the_field_it_refuses() {
         ("resolver:", "substeps: ", "4294967", "substeps"),
         ("narrow:", "impulse: ", "NaN", "impulse"),
         ("narrow:", "local_p2: ", "1e30", "local_p"),
+        // A pair's record of where its contacts are, and a contact's impulse, which the
+        // pair's points take back at the next step.
+        ("emitted:", "first: ", "99999", "emitted"),
+        ("emitted:", "count: ", "6", "another pair's"),
+        (
+            "contacts: [\n            BodyContact(",
+            "impulse: ",
+            "1e30",
+            "impulse",
+        ),
     ];
     for (after, field, to, named) in cases {
         let e = snapshot_error(after, field, to);

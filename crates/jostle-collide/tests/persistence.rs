@@ -176,3 +176,79 @@ fn pairs_that_leave_the_candidate_list_are_dropped() {
     assert_eq!(stats.candidate_pairs, 0);
     assert_eq!(scene.narrow.pair_count(), 0);
 }
+
+/// Splits every update into `parts` parts, run one after the other on the calling thread.
+struct Parts(usize);
+
+impl jostle_collide::Runner for Parts {
+    fn parts(&self, _pairs: usize) -> usize {
+        self.0
+    }
+    fn run(&self, n: usize, f: &(dyn Fn(usize) + Sync)) {
+        (0..n).rev().for_each(f);
+    }
+}
+
+/// A row of resting cubes with a distinct impulse and preload stored for every contact.
+fn row_with_stored_impulses(cubes: usize) -> (Scene, Vec<jostle_collide::ColliderHandle>) {
+    let mut scene = Scene::new();
+    scene.fixed(&ground(), Vec3::ZERO);
+    let colliders = (0..cubes)
+        .map(|i| {
+            let at = Vec3::new(3.0 * i as f32, 0.99, 0.0);
+            scene.add(&unit_cube(), at, Quat::IDENTITY, false).1
+        })
+        .collect();
+    scene.step();
+    for i in 0..scene.contacts().len() {
+        let impulse = Vec3::new(1.0 + i as f32, 0.0, 0.5);
+        scene.narrow.store_point(i, impulse, 1e-4 * i as f32);
+    }
+    (scene, colliders)
+}
+
+#[test]
+fn stored_impulses_warm_start_the_next_update_in_any_number_of_parts() {
+    // The points take their stored impulses back while their pair is updated, from where the
+    // pair's contacts were in the last update's list, whichever part found them.
+    for (first, second) in [(1, 1), (1, 3), (3, 1), (3, 2), (8, 8)] {
+        let (mut scene, _) = row_with_stored_impulses(7);
+        let stored = scene.contacts().to_vec();
+        let Scene {
+            bodies,
+            colliders,
+            broad,
+            narrow,
+            settings,
+        } = &mut scene;
+        for parts in [first, second] {
+            let pairs = broad.update(colliders, bodies, settings.prediction);
+            let stats =
+                narrow.update_with(pairs, colliders, bodies, settings, None, 0.0, &Parts(parts));
+            assert_eq!(stats.parts, parts.min(7));
+            assert_eq!(
+                narrow.contacts(),
+                &stored[..],
+                "{first} then {second} parts"
+            );
+        }
+    }
+}
+
+#[test]
+fn stored_impulses_survive_removing_another_collider() {
+    let (mut scene, colliders) = row_with_stored_impulses(3);
+    let stored = scene.contacts().to_vec();
+    let gone = colliders[1];
+    scene.narrow.remove_colliders(|c| c == gone);
+    scene.colliders.remove(gone);
+    scene.step();
+    let (kept, removed): (Vec<_>, Vec<_>) =
+        stored.chunks(4).enumerate().partition(|(i, _)| *i != 1);
+    assert_eq!(removed.len(), 1);
+    let kept: Vec<_> = kept
+        .into_iter()
+        .flat_map(|(_, c)| c.iter().copied())
+        .collect();
+    assert_eq!(scene.contacts(), &kept[..]);
+}
