@@ -1754,11 +1754,23 @@ pub fn results(
     batches: &Batches,
     states: &mut [BodyState],
     stored: bool,
+    f: impl FnMut(u32, jostle_math::Vec3, f32, ManifoldEnd),
+) {
+    let all = 0..batches.manifolds.len();
+    results_range(batches, share(states), stored, all, f);
+}
+
+/// [`results`] for the batches `range` of `batches.manifolds`, with the body states shared
+/// (only read), so that several threads may each take a range.
+pub fn results_range(
+    batches: &Batches,
+    states: &[Shared<BodyState>],
+    stored: bool,
+    range: std::ops::Range<usize>,
     mut f: impl FnMut(u32, jostle_math::Vec3, f32, ManifoldEnd),
 ) {
-    let states = share(states);
     let mut separations = [F8::ZERO; MAX_POINTS];
-    for m in &batches.manifolds {
+    for m in batches.manifolds.get(range).unwrap_or_default() {
         let motion = (!stored).then(|| (gather_motion(states, m.a), gather_motion(states, m.b)));
         let range = m.first as usize..(m.first + m.count) as usize;
         let mut ends = [ManifoldEnd::default(); LANES];
