@@ -670,9 +670,15 @@ pub(crate) fn scatter(
         body.clear_forces();
     }
     // Contacts the resolver did not see (between two fixed or sleeping bodies) keep theirs.
-    for (contact, &source) in scratch.contacts.iter().zip(&scratch.contact_source) {
-        narrow.store_point(source as usize, contact.impulse, contact.preload);
-    }
+    let (contacts, sources) = (&scratch.contacts, &scratch.contact_source);
+    narrow.store_points_with(
+        contacts.len().min(sources.len()),
+        &|i| {
+            let c = &contacts[i];
+            (sources[i] as usize, c.impulse, c.preload)
+        },
+        &scratch.narrow_runner,
+    );
 }
 
 /// When sleeping is enabled: updates motion averages, finds islands and puts resting islands to

@@ -806,6 +806,73 @@ impl NarrowPhase {
         }
     }
 
+    /// [`NarrowPhase::store_point`] for the `count` points `point(0)`, `point(1)`, ... (each
+    /// a contact index, impulse and preload), whose indices should increase: the points are
+    /// split into as many parts as `runner` asks for, each writing its own run of the
+    /// contacts, possibly on several threads (a scene's contacts outgrow the cache, and each
+    /// write is then a miss: on the 3D pyramid of 20 layers, 80,000 contacts, the copy took
+    /// 0.8 ms a step on one thread). Indices out of order are stored one after the other
+    /// instead, with the same result.
+    pub fn store_points_with(
+        &mut self,
+        count: usize,
+        point: &(dyn Fn(usize) -> (usize, Vec3, f32) + Sync),
+        runner: &dyn Runner,
+    ) {
+        let parts = runner.parts(count).clamp(1, MAX_PARTS).min(count.max(1));
+        let sequential = |narrow: &mut Self| {
+            for i in 0..count {
+                let (index, impulse, preload) = point(i);
+                narrow.store_point(index, impulse, preload);
+            }
+        };
+        if parts == 1 {
+            return sequential(self);
+        }
+        // Part k stores the points from ⌊k·count/parts⌋ into the contacts from its first
+        // point's index on, which are its own if the indices increase.
+        let first = |k: usize| k * count / parts;
+        let mut starts = [0usize; MAX_PARTS + 1];
+        for (k, start) in starts.iter_mut().enumerate().take(parts) {
+            *start = point(first(k)).0;
+        }
+        starts[parts] = self.contacts.len();
+        if starts[..=parts].windows(2).any(|w| w[0] > w[1]) {
+            return sequential(self);
+        }
+        let mut rest = self.contacts.as_mut_slice();
+        let cells: [std::sync::Mutex<Option<&mut [BodyContact]>>; MAX_PARTS] =
+            std::array::from_fn(|_| std::sync::Mutex::new(None));
+        for (k, cell) in cells.iter().enumerate().take(parts) {
+            let (own, tail) = std::mem::take(&mut rest).split_at_mut(starts[k + 1] - starts[k]);
+            *cell.lock().unwrap_or_else(|e| e.into_inner()) = Some(own);
+            rest = tail;
+        }
+        let in_order = std::sync::atomic::AtomicBool::new(true);
+        runner.run(parts, &|k| {
+            let Some(cell) = cells.get(k) else {
+                return;
+            };
+            let mut guard = cell.lock().unwrap_or_else(|e| e.into_inner());
+            let Some(own) = guard.as_mut() else {
+                return;
+            };
+            for i in first(k)..first(k + 1) {
+                let (index, impulse, preload) = point(i);
+                match index.checked_sub(starts[k]).and_then(|at| own.get_mut(at)) {
+                    Some(c) => {
+                        c.impulse = impulse;
+                        c.preload = preload;
+                    }
+                    None => in_order.store(false, std::sync::atomic::Ordering::Relaxed),
+                }
+            }
+        });
+        if !in_order.into_inner() {
+            sequential(self);
+        }
+    }
+
     /// Contact `index`; `None` with a failed debug assertion for an index past the contacts.
     #[inline]
     fn contact_mut(&mut self, index: usize) -> Option<&mut BodyContact> {

@@ -252,3 +252,44 @@ fn stored_impulses_survive_removing_another_collider() {
         .collect();
     assert_eq!(scene.contacts(), &kept[..]);
 }
+
+#[test]
+fn points_stored_in_parts_are_stored_as_one_after_the_other() {
+    // In order (as the facade stores them), with gaps, and out of order (stored one after the
+    // other instead): the same contacts as `store_point` point by point.
+    let orders: [fn(usize) -> Vec<usize>; 4] = [
+        |n| (0..n).collect(),
+        |n| (0..n).filter(|i| i % 3 != 1).collect(),
+        |n| (0..n).rev().collect(),
+        // Every part starts where it would in order, but two points are in the wrong parts.
+        |n| {
+            let mut v: Vec<usize> = (0..n).collect();
+            v.swap(1, n - 2);
+            v
+        },
+    ];
+    for order in orders {
+        for parts in [1, 2, 3, 8] {
+            let (mut scene, _) = row_with_stored_impulses(7);
+            let mut expected = scene.narrow.clone();
+            let indices = order(scene.contacts().len());
+            let point = |i: usize| {
+                let index = indices[i];
+                (
+                    index,
+                    Vec3::new(0.5, index as f32, 2.0),
+                    0.25 * index as f32,
+                )
+            };
+            for i in 0..indices.len() {
+                let (index, impulse, preload) = point(i);
+                expected.store_point(index, impulse, preload);
+            }
+            scene
+                .narrow
+                .store_points_with(indices.len(), &point, &Parts(parts));
+            assert_eq!(scene.contacts(), expected.contacts(), "{parts} parts");
+            assert_eq!(scene.contacts()[2].preload, 0.5);
+        }
+    }
+}
