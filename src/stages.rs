@@ -5,8 +5,8 @@ use crate::StepReport;
 use crate::profile::StepProfile;
 use jostle_body::{BodySet, CcdMode, apply_forces};
 use jostle_collide::{
-    BodyContact, BroadPhase, CcdSettings, CcdShape, ColliderHandle, ColliderSet, Material,
-    NarrowPhase, Pose,
+    BodyContact, BroadPhase, CcdSettings, CcdShape, ColliderHandle, ColliderSet, MAX_PARTS,
+    Material, NarrowPhase, Pose, Runner,
 };
 use jostle_math::{Mat3, Vec3, skew};
 use jostle_resolve::{Contact, STATIC_BODY, SolverBody};
@@ -140,8 +140,10 @@ pub(crate) fn wake_touching(
 /// Copies the awake bodies into the dense solver array (after applying their forces and
 /// damping) and the contacts between solver bodies into solver contacts. Bodies whose state is
 /// not finite are frozen here, before they can spread NaN to their neighbours.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn gather(
     bodies: &mut BodySet,
+    colliders: &ColliderSet,
     contacts: &[BodyContact],
     dt: f32,
     gravity: Vec3,
@@ -151,9 +153,14 @@ pub(crate) fn gather(
     // Which contacts slide, before the forces change the velocities; only where a dynamic
     // coefficient differs from the static one (every other scene skips this).
     scratch.sliding.clear();
-    if contacts
+    // (Only a collider's material can give a contact a dynamic coefficient: without one the
+    // contacts are not walked.)
+    if colliders
         .iter()
-        .any(|c| c.dynamic_friction.is_some_and(|d| d != c.friction))
+        .any(|(_, c)| c.material.dynamic_friction.is_some())
+        && contacts
+            .iter()
+            .any(|c| c.dynamic_friction.is_some_and(|d| d != c.friction))
     {
         scratch
             .sliding
@@ -237,23 +244,152 @@ pub(crate) fn gather(
         sb.last_acceleration = body.last_acceleration;
         scratch.bodies.push(sb);
     }
-    scratch.contacts.clear();
-    scratch.contact_source.clear();
+    gather_contacts(bodies, contacts, scratch);
+}
+
+/// The read-only inputs of [`convert_contacts`].
+struct ContactInputs<'a> {
+    bodies: &'a BodySet,
+    contacts: &'a [BodyContact],
+    solver_index: &'a [u32],
+    solver_bodies: &'a [SolverBody],
+    sliding: &'a [bool],
+}
+
+/// Converts the narrow phase's contacts between solver bodies into solver contacts
+/// (`scratch.contacts`, with `scratch.contact_source`). On the narrow phase's threads a run
+/// of the contacts each, converted into the same places of the output; where a run keeps
+/// fewer contacts than it has, the runs after it move down to close the gap (the contacts
+/// between solver bodies are usually all of them, and then nothing moves). On the 3D pyramid
+/// of 20 layers (80,000 contacts, two threads) the conversion took 1.2 ms a step on one.
+fn gather_contacts(bodies: &BodySet, contacts: &[BodyContact], scratch: &mut Scratch) {
+    let Scratch {
+        bodies: solver_bodies,
+        narrow_runner,
+        contacts: out,
+        contact_source: sources,
+        solver_index,
+        sliding,
+        ..
+    } = scratch;
+    let input = ContactInputs {
+        bodies,
+        contacts,
+        solver_index,
+        solver_bodies,
+        sliding,
+    };
+    convert_all(&input, out, sources, narrow_runner);
+}
+
+/// A part's run of the output of [`convert_all`] and how many contacts it kept, for
+/// whichever thread runs it.
+type PartCell<'a> = std::sync::Mutex<Option<(&'a mut [Contact], &'a mut [u32], usize)>>;
+
+/// [`convert_contacts`] over all of `input.contacts` into `out` and `sources`, in as many
+/// parts as `runner` asks for ([`gather_contacts`]).
+fn convert_all(
+    input: &ContactInputs<'_>,
+    out: &mut Vec<Contact>,
+    sources: &mut Vec<u32>,
+    runner: &dyn Runner,
+) {
+    let n = input.contacts.len();
+    let parts = runner.parts(n).clamp(1, MAX_PARTS).min(n.max(1));
+    if parts == 1 {
+        out.clear();
+        sources.clear();
+        out.reserve(n);
+        sources.reserve(n);
+        convert_contacts(input, 0..n, |c, i| {
+            out.push(c);
+            sources.push(i);
+        });
+        return;
+    }
+    // Part k converts the contacts from ⌊k·n/parts⌋ into the same places of the output.
+    out.resize(
+        n,
+        Contact::new(STATIC_BODY, STATIC_BODY, Vec3::ZERO, Vec3::Y, 0.0),
+    );
+    sources.resize(n, 0);
+    let first = |k: usize| k * n / parts;
+    let cells: [PartCell<'_>; MAX_PARTS] = std::array::from_fn(|_| std::sync::Mutex::new(None));
+    let (mut rest_out, mut rest_sources) = (out.as_mut_slice(), sources.as_mut_slice());
+    for (k, cell) in cells.iter().enumerate().take(parts) {
+        let len = first(k + 1) - first(k);
+        let (own_out, tail_out) = std::mem::take(&mut rest_out).split_at_mut(len);
+        let (own_sources, tail_sources) = std::mem::take(&mut rest_sources).split_at_mut(len);
+        *cell.lock().unwrap_or_else(|e| e.into_inner()) = Some((own_out, own_sources, 0));
+        (rest_out, rest_sources) = (tail_out, tail_sources);
+    }
+    runner.run(parts, &|k| {
+        let Some(cell) = cells.get(k) else {
+            return;
+        };
+        let mut guard = cell.lock().unwrap_or_else(|e| e.into_inner());
+        let Some((own_out, own_sources, kept)) = guard.as_mut() else {
+            return;
+        };
+        convert_contacts(input, first(k)..first(k + 1), |c, i| {
+            own_out[*kept] = c;
+            own_sources[*kept] = i;
+            *kept += 1;
+        });
+    });
+    let kept: Vec<usize> = cells
+        .into_iter()
+        .take(parts)
+        .map(|cell| {
+            let cell = cell.into_inner().unwrap_or_else(|e| e.into_inner());
+            cell.map_or(0, |(_, _, kept)| kept)
+        })
+        .collect();
+    let mut end = 0;
+    for (k, &kept) in kept.iter().enumerate() {
+        let from = first(k);
+        if from != end {
+            out.copy_within(from..from + kept, end);
+            sources.copy_within(from..from + kept, end);
+        }
+        end += kept;
+    }
+    out.truncate(end);
+    sources.truncate(end);
+}
+
+/// Calls `keep(contact, index)` in order for each contact of `input.contacts[range]` between
+/// solver bodies that something can push, as a solver contact.
+fn convert_contacts(
+    input: &ContactInputs<'_>,
+    range: std::ops::Range<usize>,
+    mut keep: impl FnMut(Contact, u32),
+) {
     let index_of = |h: jostle_body::BodyHandle| -> Option<u32> {
-        let body = bodies.get(h)?;
-        let resting_kinematic =
-            body.is_kinematic() && scratch.solver_index[h.index() as usize] == NO_SOLVER;
+        let body = input.bodies.get(h)?;
+        let solver = input
+            .solver_index
+            .get(h.index() as usize)
+            .copied()
+            .unwrap_or(NO_SOLVER);
+        let resting_kinematic = body.is_kinematic() && solver == NO_SOLVER;
         if body.is_fixed() || resting_kinematic {
             Some(STATIC_BODY)
         } else {
-            let i = scratch.solver_index[h.index() as usize];
-            (i != NO_SOLVER).then_some(i)
+            (solver != NO_SOLVER).then_some(solver)
         }
+    };
+    let inv_mass = |i: u32| {
+        input
+            .solver_bodies
+            .get(i as usize)
+            .map_or(0.0, |b| b.inv_mass)
     };
     // A pair's points are listed together: their bodies are looked up once.
     type Pair = (jostle_body::BodyHandle, jostle_body::BodyHandle);
     let mut last: Option<(Pair, Option<(u32, u32)>)> = None;
-    for (i, c) in contacts.iter().enumerate() {
+    for i in range {
+        let c = &input.contacts[i];
         let indices = match last {
             Some((pair, indices)) if pair == (c.a, c.b) => indices,
             _ => {
@@ -269,14 +405,13 @@ pub(crate) fn gather(
             continue;
         }
         // Nothing to resolve between two bodies that nothing can push (kinematic ones).
-        if scratch.bodies[a as usize].inv_mass == 0.0 && scratch.bodies[b as usize].inv_mass == 0.0
-        {
+        if inv_mass(a) == 0.0 && inv_mass(b) == 0.0 {
             continue;
         }
         // Static friction holds a contact that is not sliding; a sliding one feels the
         // dynamic coefficient for this step.
         let friction = match c.dynamic_friction {
-            Some(d) if scratch.sliding.get(i).copied().unwrap_or(false) => d,
+            Some(d) if input.sliding.get(i).copied().unwrap_or(false) => d,
             _ => c.friction,
         };
         let mut contact = Contact::new(a, b, c.point, c.normal, c.penetration)
@@ -285,8 +420,7 @@ pub(crate) fn gather(
         contact.impulse = c.impulse;
         contact.point_b = c.point_b;
         contact.preload = c.preload;
-        scratch.contacts.push(contact);
-        scratch.contact_source.push(i as u32);
+        keep(contact, i as u32);
     }
 }
 
@@ -723,6 +857,105 @@ pub(crate) fn sleep(
             } else {
                 p.sleeping_bodies += 1;
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use jostle_body::RigidBody;
+    use jostle_math::Quat;
+
+    /// Splits into `.0` parts, run last first on the calling thread.
+    struct Parts(usize);
+
+    impl Runner for Parts {
+        fn parts(&self, _items: usize) -> usize {
+            self.0
+        }
+        fn run(&self, n: usize, f: &(dyn Fn(usize) + Sync)) {
+            (0..n).rev().for_each(f);
+        }
+    }
+
+    #[test]
+    fn contacts_converted_in_parts_are_those_converted_in_one() {
+        // A ground, three awake dynamic bodies and a sleeping one; the contacts with the
+        // sleeper and between two fixed bodies are not converted, so runs of the output keep
+        // fewer contacts than they have and the runs after them move down.
+        let mut bodies = BodySet::new();
+        let ground = bodies.insert(RigidBody::fixed());
+        let ground_2 = bodies.insert(RigidBody::fixed());
+        let body = |bodies: &mut BodySet, x: f32| {
+            let b = RigidBody::dynamic(1.0, Mat3::IDENTITY).expect("a valid mass");
+            bodies.insert(b.with_pose(Vec3::new(x, 0.5, 0.0), Quat::IDENTITY))
+        };
+        let awake = [
+            body(&mut bodies, 0.0),
+            body(&mut bodies, 2.0),
+            body(&mut bodies, 4.0),
+        ];
+        let asleep = body(&mut bodies, 6.0);
+        let mut solver_index = vec![NO_SOLVER; bodies.capacity_index()];
+        let mut solver_bodies = vec![SolverBody::STATIC];
+        for h in awake {
+            solver_index[h.index() as usize] = solver_bodies.len() as u32;
+            let b = bodies.get(h).expect("inserted");
+            solver_bodies.push(SolverBody::new(
+                b.position,
+                b.orientation,
+                1.0,
+                Mat3::IDENTITY,
+            ));
+        }
+        let pairs = [
+            (awake[0], ground),
+            (asleep, ground),
+            (awake[1], awake[0]),
+            (ground_2, ground),
+            (awake[2], asleep),
+            (awake[2], awake[1]),
+        ];
+        let contacts: Vec<BodyContact> = (0..61)
+            .map(|i| {
+                let (a, b) = pairs[(i / 3) % pairs.len()];
+                BodyContact {
+                    a,
+                    b,
+                    point: Vec3::new(i as f32, 0.0, 0.0),
+                    point_b: Vec3::new(i as f32, -0.01, 0.0),
+                    normal: Vec3::Y,
+                    penetration: 0.01,
+                    friction: 0.5,
+                    dynamic_friction: None,
+                    restitution: 0.0,
+                    impulse: Vec3::new(1.0, 0.0, i as f32),
+                    preload: 1e-4 * i as f32,
+                }
+            })
+            .collect();
+        let input = ContactInputs {
+            bodies: &bodies,
+            contacts: &contacts,
+            solver_index: &solver_index,
+            solver_bodies: &solver_bodies,
+            sliding: &[],
+        };
+        let (mut one, mut one_sources) = (Vec::new(), Vec::new());
+        convert_all(&input, &mut one, &mut one_sources, &Parts(1));
+        assert!(
+            one.len() > 20 && one.len() < contacts.len(),
+            "{}",
+            one.len()
+        );
+        assert!(one_sources.windows(2).all(|w| w[0] < w[1]));
+        for parts in [2, 3, 7, 8] {
+            // Outputs left over from a longer list, as between steps.
+            let mut out = vec![one[0]; 100];
+            let mut sources = vec![7; 100];
+            convert_all(&input, &mut out, &mut sources, &Parts(parts));
+            assert_eq!((&out, &sources), (&one, &one_sources), "{parts} parts");
         }
     }
 }

@@ -1438,6 +1438,7 @@ impl World {
         let t = Stopwatch::start();
         stages::gather(
             &mut self.bodies,
+            &self.colliders,
             self.narrow.contacts(),
             dt,
             self.settings.gravity,
