@@ -299,12 +299,27 @@ impl Batches {
         speculative_margin: f32,
         params: &PrepareParams,
     ) {
+        self.arrange_with(contacts, bodies, speculative_margin, params, |_| {});
+    }
+
+    /// [`Batches::arrange`], calling `each` on every contact, in order, as it is looked at
+    /// (whether it takes part or not): a caller with its own pass over the contacts saves
+    /// reading them twice, which at scale streams them from memory twice.
+    pub fn arrange_with(
+        &mut self,
+        contacts: &[Contact],
+        bodies: &[SolverBody],
+        speculative_margin: f32,
+        params: &PrepareParams,
+        mut each: impl FnMut(&Contact),
+    ) {
         self.any_restitution = false;
         // Which contacts take part, compared entry by entry with the last layout's as they
         // are found.
         let mut same = self.layout_lengths.is_some();
         let mut kept = 0;
         for (i, c) in contacts.iter().enumerate() {
+            each(c);
             let (ba, bb) = (&bodies[c.a as usize], &bodies[c.b as usize]);
             let gap = -c.penetration;
             let within = gap <= speculative_margin

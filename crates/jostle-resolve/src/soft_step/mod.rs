@@ -390,39 +390,6 @@ impl SoftStepResolver {
         true
     }
 
-    /// Marks the bodies that have contact rows this step (`rows_inverse`), for the gyroscopic
-    /// term, and which of them touch a body that can move (`touches_moving`).
-    fn mark_contact_rows(&mut self, bodies: &[SolverBody], contacts: &[Contact]) {
-        self.rows_inverse.clear();
-        self.touches_moving.clear();
-        if !self.settings.gyroscopic {
-            return;
-        }
-        self.rows_inverse.resize(bodies.len(), Mat3::ZERO);
-        self.touches_moving.resize(bodies.len(), false);
-        let moves = |k: u32| bodies.get(k as usize).is_some_and(|b| b.inv_mass > 0.0);
-        let mut last = None;
-        for c in contacts {
-            // A manifold's points come one after another and mark the same two bodies.
-            if last == Some((c.a, c.b)) {
-                continue;
-            }
-            last = Some((c.a, c.b));
-            let both = moves(c.a) && moves(c.b);
-            for k in [c.a, c.b] {
-                if k != STATIC_BODY
-                    && let (Some(r), Some(b)) = (
-                        self.rows_inverse.get_mut(k as usize),
-                        bodies.get(k as usize),
-                    )
-                {
-                    *r = b.inv_inertia;
-                    self.touches_moving[k as usize] |= both;
-                }
-            }
-        }
-    }
-
     /// The energy bound of a body that turned away from its contact rows: a body whose
     /// inertia has turned within the step so far from the step-start inertia its contact rows
     /// use that its turns fell back to ω alone (`gyroscopic::turn_against`), and that touches
@@ -568,8 +535,38 @@ impl SoftStepResolver {
             step: h * s.substeps.max(1) as f32,
             down: gravity.normalize_or_zero(),
         };
+        // The bodies that have contact rows this step (`rows_inverse`), for the gyroscopic
+        // term, and which of them touch a body that can move (`touches_moving`), marked in
+        // the same pass over the contacts.
+        self.rows_inverse.clear();
+        self.touches_moving.clear();
+        let gyroscopic = s.gyroscopic;
+        if gyroscopic {
+            self.rows_inverse.resize(bodies.len(), Mat3::ZERO);
+            self.touches_moving.resize(bodies.len(), false);
+        }
+        let (rows_inverse, touches_moving) = (&mut self.rows_inverse, &mut self.touches_moving);
+        let moves = |k: u32| bodies.get(k as usize).is_some_and(|b| b.inv_mass > 0.0);
+        let mut last = None;
+        let mark_rows = |c: &Contact| {
+            // A manifold's points come one after another and mark the same two bodies.
+            if !gyroscopic || last == Some((c.a, c.b)) {
+                return;
+            }
+            last = Some((c.a, c.b));
+            let both = moves(c.a) && moves(c.b);
+            for k in [c.a, c.b] {
+                if k != STATIC_BODY
+                    && let (Some(r), Some(b)) =
+                        (rows_inverse.get_mut(k as usize), bodies.get(k as usize))
+                {
+                    *r = b.inv_inertia;
+                    touches_moving[k as usize] |= both;
+                }
+            }
+        };
         self.batches
-            .arrange(contacts, bodies, s.speculative_margin, &params);
+            .arrange_with(contacts, bodies, s.speculative_margin, &params, mark_rows);
         params
     }
 
@@ -1072,7 +1069,6 @@ impl Resolver for SoftStepResolver {
         self.load_bodies(bodies);
         let params = self.arrange_contacts(bodies, contacts, h, ctx.gravity);
         let any_restitution = self.batches.any_restitution;
-        self.mark_contact_rows(bodies, contacts);
         self.mark_free();
         let exact_warm = self.mark_exact_warm();
         let threads = if self.batches.manifolds.len() >= PARALLEL_MIN_BATCHES {
@@ -1266,8 +1262,12 @@ impl Resolver for SoftStepResolver {
         relax_time += t.elapsed();
 
         let t = Stopwatch::start();
-        for c in contacts.iter_mut() {
-            c.impulse = jostle_math::Vec3::ZERO;
+        // Contacts that took no part get a zero impulse; every other gets its own below (when
+        // all took part, as usually, the contacts are not walked an extra time).
+        if self.batches.contacts as usize != contacts.len() {
+            for c in contacts.iter_mut() {
+                c.impulse = jostle_math::Vec3::ZERO;
+            }
         }
         let (rate, target) = (self.settings.preload_rate, self.settings.preload_target);
         // The relax pass of the last substep stored every point's separation at the poses
