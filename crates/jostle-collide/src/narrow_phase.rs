@@ -746,17 +746,6 @@ impl NarrowPhase {
         if kept as usize == self.pairs.len() {
             return;
         }
-        // The list changes: every point takes back its contact's impulse now.
-        let Self {
-            pairs,
-            contacts,
-            slots,
-            bases,
-            ..
-        } = self;
-        for state in pairs.iter_mut() {
-            state.take_back(contacts, slots, bases);
-        }
         let mut i = 0;
         self.pairs.retain(|_| {
             i += 1;
@@ -772,6 +761,27 @@ impl NarrowPhase {
         }
         self.contacts = contacts;
         self.slots = slots;
+        // Each remaining pair's record of its contacts, which kept their values, in the new
+        // list (one part).
+        for state in &mut self.pairs {
+            state.emitted = None;
+        }
+        let mut first = 0;
+        for run in self.slots.chunk_by(|x, y| x.pair == y.pair) {
+            if let Some(state) = run
+                .first()
+                .and_then(|s| self.pairs.get_mut(s.pair as usize))
+            {
+                state.emitted = Some(Emitted {
+                    part: 0,
+                    first,
+                    count: run.len() as u32,
+                });
+            }
+            first += run.len() as u32;
+        }
+        self.bases.clear();
+        self.bases.push(0);
     }
 
     /// Writes the resolver's accumulated impulses back, one per contact of

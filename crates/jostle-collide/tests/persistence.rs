@@ -236,6 +236,24 @@ fn stored_impulses_warm_start_the_next_update_in_any_number_of_parts() {
 }
 
 #[test]
+fn impulses_stored_after_removing_a_collider_warm_start_the_next_update() {
+    // Removal between the update and the store: the remaining contacts keep their indices
+    // in the list, and what is stored there reaches the next update.
+    let (mut scene, colliders) = row_with_stored_impulses(3);
+    let gone = colliders[0];
+    scene.narrow.remove_colliders(|c| c == gone);
+    scene.colliders.remove(gone);
+    for i in 0..scene.contacts().len() {
+        scene
+            .narrow
+            .store_point(i, Vec3::new(7.0 + i as f32, 0.0, 0.0), 0.5);
+    }
+    let stored = scene.contacts().to_vec();
+    scene.step();
+    assert_eq!(scene.contacts(), &stored[..]);
+}
+
+#[test]
 fn stored_impulses_survive_removing_another_collider() {
     let (mut scene, colliders) = row_with_stored_impulses(3);
     let stored = scene.contacts().to_vec();
