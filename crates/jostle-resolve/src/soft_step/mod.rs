@@ -201,15 +201,19 @@ pub struct SoftStepResolver {
 /// Steps between two trials of the mode not in use ([`ThreadChoice`]).
 const PROBE_INTERVAL: u32 = 32;
 
-/// Weight of a new measurement in a mode's running cost ([`ThreadChoice`]).
-const COST_WEIGHT: f64 = 0.25;
+/// Counted runs of each mode whose least cost is the mode's cost ([`ThreadChoice`]).
+const RECENT_RUNS: usize = 4;
 
 /// Which runs a large step's substeps faster on this machine: the team of threads or the
 /// calling thread alone (the choice takes the step's preparation of the points with it,
 /// [`SoftStepResolver::prepare_points`]; its clock measures the substeps). Both give the
 /// same results bit for bit (`tests/threads.rs` of the `jostle` crate), so the choice is
 /// free to follow the clock: each mode's cost per contact
-/// point is a running average of its measured substep time, the cheaper one runs, and every
+/// point is the least of its last [`RECENT_RUNS`] measured substep times (a run is only ever
+/// slowed by what else the machine does, most of all a team whose second core was taken for a
+/// while: with a running average instead, a few slow team runs on a busy virtual machine kept
+/// the 3D pyramid of 10 layers on one thread for most of its steps, 1.84–1.95 ms a step, where
+/// the team takes 1.61–1.62), the cheaper one runs, and every
 /// [`PROBE_INTERVAL`] steps the other runs once to keep its figure current (the first run of
 /// each is not counted: it starts the helper threads or warms the caches). Measured why: on
 /// one two-core virtual machine the team took the 3D pyramid of 10 layers (315 batches) from
@@ -217,8 +221,10 @@ const COST_WEIGHT: f64 = 0.25;
 /// chosen by the clock").
 #[derive(Clone, Copy, Debug, Default)]
 struct ThreadChoice {
-    /// Running cost per point (ns): one thread, the team.
+    /// Cost per point (ns): one thread, the team; the least of `recent`.
     cost: [Option<f64>; 2],
+    /// The last [`RECENT_RUNS`] counted costs per point of each mode (0: none yet), in a ring.
+    recent: [[f64; RECENT_RUNS]; 2],
     /// Runs of each mode so far (saturating).
     runs: [u32; 2],
     /// Steps since the mode not in use last ran.
@@ -255,10 +261,13 @@ impl ThreadChoice {
             return;
         }
         let cost = time.as_nanos() as f64 / points as f64;
-        self.cost[mode] = Some(match self.cost[mode] {
-            Some(old) => old + COST_WEIGHT * (cost - old),
-            None => cost,
-        });
+        let recent = &mut self.recent[mode];
+        recent[self.runs[mode] as usize % RECENT_RUNS] = cost;
+        self.cost[mode] = recent
+            .iter()
+            .copied()
+            .filter(|&c| c > 0.0)
+            .min_by(f64::total_cmp);
     }
 }
 
@@ -1359,13 +1368,39 @@ mod thread_choice_tests {
             "the team runs but for probes"
         );
         // The machine changes: one thread becomes faster, and the probes notice within a few
-        // of them (each moves the running cost a quarter of the way).
+        // of them (a mode's cost is the least of its last few runs).
         team_steps(&mut choice, 6 * PROBE_INTERVAL, 500, 1000);
         let on_team = team_steps(&mut choice, 4 * PROBE_INTERVAL, 500, 1000);
         assert!(
             on_team <= 5,
             "{on_team} of {} steps on the slower team",
             4 * PROBE_INTERVAL
+        );
+    }
+
+    #[test]
+    fn occasional_slow_team_runs_do_not_hide_a_faster_team() {
+        // Every other team run is slowed threefold (its second core taken for a while): the
+        // team's undisturbed runs are still the faster, and it keeps running.
+        let mut choice = ThreadChoice::default();
+        let (mut on_team, mut team_runs) = (0, 0u32);
+        for step in 0..20 * PROBE_INTERVAL {
+            let use_team = choice.use_team();
+            let cost = if use_team {
+                team_runs += 1;
+                if team_runs % 2 == 0 { 3000 } else { 1000 }
+            } else {
+                1500
+            };
+            choice.record(use_team, Duration::from_nanos(cost * 100), 100);
+            if step >= 4 * PROBE_INTERVAL {
+                on_team += u32::from(use_team);
+            }
+        }
+        let steps = 16 * PROBE_INTERVAL;
+        assert!(
+            on_team * 10 >= steps * 9,
+            "{on_team} of {steps} steps on the team"
         );
     }
 
