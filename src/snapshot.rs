@@ -3,7 +3,7 @@
 //! with serde so that a run can stop and continue **bit for bit**: N steps, a snapshot, then M
 //! steps give exactly the trace of N + M steps in one run.
 //!
-//! Files are RON (`Snapshot(format: 2, ...)`); floats are written in Rust's shortest
+//! Files are RON (`Snapshot(format: 3, ...)`); floats are written in Rust's shortest
 //! round-trip form, so nothing is lost. The broad phase is not stored: its pairs are a pure
 //! function of the poses (sorted, filtered exactly), so it is rebuilt on the first step.
 
@@ -37,7 +37,7 @@ pub struct ColliderRecord {
 }
 
 #[cfg(feature = "scene")]
-pub use file::{SNAPSHOT_FORMAT, Snapshot, SnapshotError};
+pub use file::{OLDEST_SNAPSHOT_FORMAT, SNAPSHOT_FORMAT, Snapshot, SnapshotError};
 
 #[cfg(feature = "scene")]
 mod file {
@@ -51,10 +51,20 @@ mod file {
     use std::path::Path;
     use thiserror::Error;
 
-    /// Version of the snapshot format this build reads and writes.
+    /// Version of the snapshot format this build writes; it reads this one and
+    /// [`OLDEST_SNAPSHOT_FORMAT`] onwards.
     /// Format 2 (2026-12-03): bodies carry their names, and the colliders are stored with
     /// their slots, generations and free list, so handles stay valid across removals.
-    pub const SNAPSHOT_FORMAT: u32 = 2;
+    /// Format 3 (2026-12-05): the resolver's impulses and preloads of the last step are in the
+    /// narrow phase's contact list, and each pair records where its contacts are (its
+    /// persistent points take them at the next step); a build that reads only format 2 would
+    /// warm start from the step before and not continue the run bit for bit, so it refuses
+    /// format 3. A format 2 snapshot, whose points hold the impulses themselves, restores as
+    /// before.
+    pub const SNAPSHOT_FORMAT: u32 = 3;
+
+    /// The oldest snapshot format this build reads ([`SNAPSHOT_FORMAT`]).
+    pub const OLDEST_SNAPSHOT_FORMAT: u32 = 2;
 
     /// The complete state of a world. Make one with [`World::snapshot`], restore it with
     /// [`World::from_snapshot`], store it with [`Snapshot::save`] / [`Snapshot::load`].
@@ -156,11 +166,12 @@ mod file {
                 column: e.span.start.col,
                 message: e.code.to_string(),
             })?;
-            if snapshot.format != SNAPSHOT_FORMAT {
+            if !(OLDEST_SNAPSHOT_FORMAT..=SNAPSHOT_FORMAT).contains(&snapshot.format) {
                 return Err(SnapshotError::Invalid {
                     file: file.into(),
                     message: format!(
-                        "snapshot format {} is not supported (this build reads {SNAPSHOT_FORMAT})",
+                        "snapshot format {} is not supported (this build reads formats \
+                         {OLDEST_SNAPSHOT_FORMAT} to {SNAPSHOT_FORMAT})",
                         snapshot.format
                     ),
                 });

@@ -120,6 +120,48 @@ fn identical_runs_write_identical_snapshots() {
     );
 }
 
+/// Snapshots name their format: this build writes `SNAPSHOT_FORMAT`, reads formats from
+/// `OLDEST_SNAPSHOT_FORMAT` on (a format 2 snapshot has no record of where each pair's
+/// contacts are, and restores from its points), and refuses a later one by number.
+#[test]
+fn snapshot_formats_are_read_from_the_oldest_supported_and_later_ones_refused() {
+    use jostle::snapshot::{OLDEST_SNAPSHOT_FORMAT, SNAPSHOT_FORMAT};
+    let s = scene("box_drop.ron");
+    let mut world = s.build().unwrap();
+    hashes(&mut world, 30);
+    let text = world.snapshot(&s.name, DT).to_ron().unwrap();
+    let current = format!("format: {SNAPSHOT_FORMAT},");
+    assert!(
+        text.contains(&current),
+        "written as format {SNAPSHOT_FORMAT}"
+    );
+    let dir = std::env::temp_dir();
+    for (format, readable) in [
+        (OLDEST_SNAPSHOT_FORMAT, true),
+        (SNAPSHOT_FORMAT, true),
+        (SNAPSHOT_FORMAT + 1, false),
+        (OLDEST_SNAPSHOT_FORMAT - 1, false),
+    ] {
+        let path = dir.join(format!("jostle-format-{format}-{}", std::process::id()));
+        std::fs::write(
+            &path,
+            text.replacen(&current, &format!("format: {format},"), 1),
+        )
+        .unwrap();
+        match Snapshot::load(&path) {
+            Ok(snapshot) => {
+                assert!(readable, "format {format} was read");
+                World::from_snapshot(snapshot).unwrap();
+            }
+            Err(e) => {
+                assert!(!readable, "format {format}: {e}");
+                assert!(e.to_string().contains(&format!("format {format}")), "{e}");
+            }
+        }
+        std::fs::remove_file(path).ok();
+    }
+}
+
 /// A snapshot edited by hand into settings a scene file would refuse is refused too, naming
 /// the setting, instead of running with them (`substeps: 0`, NaN gravity) or stopping the
 /// process on an assertion in parry (a negative `collide.prediction`) (issue 16).
