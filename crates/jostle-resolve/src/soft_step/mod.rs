@@ -625,16 +625,28 @@ impl SoftStepResolver {
             params,
             factor,
         };
-        let plan = Plan {
-            threads,
-            stages: Default::default(),
-        };
-        work.run(&plan);
-        self.plan.clear();
-        self.plan.append(&mut plan.stages.borrow_mut());
-        self.team.reset(threads, &self.plan);
-        team::run(&self.team, |member| work.run(member));
+        run_on_team(&mut self.team, &mut self.plan, threads, &work);
     }
+}
+
+/// Work that runs as a fixed sequence of stages on any [`Crew`].
+trait Staged: Sync {
+    /// The stages, in order, on `crew`.
+    fn run(&self, crew: &impl Crew);
+}
+
+/// Runs `work` on `team` with `threads` threads: first on a [`Plan`], which learns its
+/// stages into `plan`, then on the team reset for them.
+fn run_on_team(team: &mut Team, plan: &mut Vec<team::Parts>, threads: usize, work: &impl Staged) {
+    let planned = Plan {
+        threads,
+        stages: Default::default(),
+    };
+    work.run(&planned);
+    plan.clear();
+    plan.append(&mut planned.stages.borrow_mut());
+    team.reset(threads, plan);
+    team::run(team, |member| work.run(member));
 }
 
 /// Batches per item of the team's stage that writes the step's results ([`Results`]).
@@ -651,7 +663,9 @@ struct Results<'a, W> {
     write: &'a W,
 }
 
-impl<W: Fn(&mut Contact, jostle_math::Vec3, f32, solve::ManifoldEnd) + Sync> Results<'_, W> {
+impl<W: Fn(&mut Contact, jostle_math::Vec3, f32, solve::ManifoldEnd) + Sync> Staged
+    for Results<'_, W>
+{
     fn run(&self, crew: &impl Crew) {
         let n = self.batches.manifolds.len();
         let items = n.div_ceil(RESULTS_CHUNK) as u32;
@@ -691,7 +705,7 @@ struct Preparation<'a> {
     factor: bool,
 }
 
-impl Preparation<'_> {
+impl Staged for Preparation<'_> {
     /// The preparation, stage by stage on `crew`.
     fn run(&self, crew: &impl Crew) {
         let (manifolds, points) = (self.manifolds, self.points);
@@ -1298,15 +1312,7 @@ impl Resolver for SoftStepResolver {
                 stored,
                 write: &write,
             };
-            let plan = Plan {
-                threads,
-                stages: Default::default(),
-            };
-            work.run(&plan);
-            self.plan.clear();
-            self.plan.append(&mut plan.stages.borrow_mut());
-            self.team.reset(threads, &self.plan);
-            team::run(&self.team, |member| work.run(member));
+            run_on_team(&mut self.team, &mut self.plan, threads, &work);
         } else {
             solve::results(
                 &self.batches,
