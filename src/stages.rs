@@ -6,7 +6,7 @@ use crate::profile::StepProfile;
 use jostle_body::{BodySet, CcdMode, apply_forces};
 use jostle_collide::{
     BodyContact, BroadPhase, CcdSettings, CcdShape, ColliderHandle, ColliderSet, MAX_PARTS,
-    Material, NarrowPhase, Pose, Runner,
+    Material, NarrowPhase, Pose, Runner, run_parts,
 };
 use jostle_math::{Mat3, Vec3, skew};
 use jostle_resolve::{Contact, STATIC_BODY, SolverBody};
@@ -140,7 +140,6 @@ pub(crate) fn wake_touching(
 /// Copies the awake bodies into the dense solver array (after applying their forces and
 /// damping) and the contacts between solver bodies into solver contacts. Bodies whose state is
 /// not finite are frozen here, before they can spread NaN to their neighbours.
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn gather(
     bodies: &mut BodySet,
     colliders: &ColliderSet,
@@ -282,10 +281,6 @@ fn gather_contacts(bodies: &BodySet, contacts: &[BodyContact], scratch: &mut Scr
     convert_all(&input, out, sources, narrow_runner);
 }
 
-/// A part's run of the output of [`convert_all`] and how many contacts it kept, for
-/// whichever thread runs it.
-type PartCell<'a> = std::sync::Mutex<Option<(&'a mut [Contact], &'a mut [u32], usize)>>;
-
 /// [`convert_contacts`] over all of `input.contacts` into `out` and `sources`, in as many
 /// parts as `runner` asks for ([`gather_contacts`]).
 fn convert_all(
@@ -314,39 +309,34 @@ fn convert_all(
     );
     sources.resize(n, 0);
     let first = |k: usize| k * n / parts;
-    let cells: [PartCell<'_>; MAX_PARTS] = std::array::from_fn(|_| std::sync::Mutex::new(None));
+    // Each part's runs of the outputs, and how many contacts it kept.
     let (mut rest_out, mut rest_sources) = (out.as_mut_slice(), sources.as_mut_slice());
-    for (k, cell) in cells.iter().enumerate().take(parts) {
-        let len = first(k + 1) - first(k);
+    let mut runs: [_; MAX_PARTS] = std::array::from_fn(|k| {
+        let len = if k < parts {
+            first(k + 1) - first(k)
+        } else {
+            0
+        };
         let (own_out, tail_out) = std::mem::take(&mut rest_out).split_at_mut(len);
         let (own_sources, tail_sources) = std::mem::take(&mut rest_sources).split_at_mut(len);
-        *cell.lock().unwrap_or_else(|e| e.into_inner()) = Some((own_out, own_sources, 0));
         (rest_out, rest_sources) = (tail_out, tail_sources);
-    }
-    runner.run(parts, &|k| {
-        let Some(cell) = cells.get(k) else {
-            return;
-        };
-        let mut guard = cell.lock().unwrap_or_else(|e| e.into_inner());
-        let Some((own_out, own_sources, kept)) = guard.as_mut() else {
-            return;
-        };
+        (own_out, own_sources, 0usize)
+    });
+    run_parts(runner, &mut runs[..parts], &|k,
+                                            (
+        own_out,
+        own_sources,
+        kept,
+    )| {
         convert_contacts(input, first(k)..first(k + 1), |c, i| {
             own_out[*kept] = c;
             own_sources[*kept] = i;
             *kept += 1;
         });
     });
-    let kept: Vec<usize> = cells
-        .into_iter()
-        .take(parts)
-        .map(|cell| {
-            let cell = cell.into_inner().unwrap_or_else(|e| e.into_inner());
-            cell.map_or(0, |(_, _, kept)| kept)
-        })
-        .collect();
+    let kept = runs.map(|(_, _, kept)| kept);
     let mut end = 0;
-    for (k, &kept) in kept.iter().enumerate() {
+    for (k, &kept) in kept.iter().take(parts).enumerate() {
         let from = first(k);
         if from != end {
             out.copy_within(from..from + kept, end);

@@ -35,7 +35,7 @@ pub use mass::{MassProps, mass_properties};
 pub use material::{Combine, Material};
 pub use narrow_phase::{
     BodyContact, CollisionEvent, ContactForceEvent, MAX_PARTS, NarrowPhase, NarrowStats, OneThread,
-    PairFilter, Runner, SensorEvent,
+    PairFilter, Runner, SensorEvent, run_parts,
 };
 pub use parry3d;
 pub use parry3d::math::Pose;

@@ -244,6 +244,15 @@ struct Emitted {
     count: u32,
 }
 
+impl Emitted {
+    /// The pair's contacts in the list whose parts start at `bases`; `None` for a part that
+    /// is not there.
+    fn range(&self, bases: &[u32]) -> Option<std::ops::Range<usize>> {
+        let at = *bases.get(self.part as usize)? as usize + self.first as usize;
+        Some(at..at.checked_add(self.count as usize)?)
+    }
+}
+
 impl PairState {
     fn new(pair: ColliderPair) -> Self {
         Self {
@@ -263,10 +272,7 @@ impl PairState {
         let Some(e) = self.emitted.take() else {
             return;
         };
-        let at = bases
-            .get(e.part as usize)
-            .map(|&b| b as usize + e.first as usize);
-        let range = at.and_then(|at| Some(at..at.checked_add(e.count as usize)?));
+        let range = e.range(bases);
         let (Some(contacts), Some(slots)) = (
             range.clone().and_then(|r| contacts.get(r)),
             range.and_then(|r| slots.get(r)),
@@ -353,6 +359,29 @@ pub trait Runner: Sync {
     fn run(&self, n: usize, f: &(dyn Fn(usize) + Sync));
 }
 
+/// Runs `f(k, &mut parts[k])` for every part (at most [`MAX_PARTS`]) on `runner`, any part
+/// on any thread, and returns when all have run: each part reaches only its own state (the
+/// outputs it writes, disjoint from the others').
+pub fn run_parts<S: Send>(
+    runner: &dyn Runner,
+    parts: &mut [S],
+    f: &(dyn Fn(usize, &mut S) + Sync),
+) {
+    debug_assert!(parts.len() <= MAX_PARTS, "{} parts", parts.len());
+    let n = parts.len().min(MAX_PARTS);
+    let mut each = parts.iter_mut();
+    let cells: [std::sync::Mutex<Option<&mut S>>; MAX_PARTS] =
+        std::array::from_fn(|_| std::sync::Mutex::new(each.next()));
+    runner.run(n, &|k| {
+        if let Some(cell) = cells.get(k) {
+            let mut part = cell.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(part) = part.as_mut() {
+                f(k, part);
+            }
+        }
+    });
+}
+
 /// A [`Runner`] that runs everything on the calling thread, in one part.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct OneThread;
@@ -383,9 +412,6 @@ struct Part {
     /// Pairs kept.
     kept: u32,
 }
-
-/// A part's pairs and outputs, for whichever thread runs it.
-type PartCell<'a> = std::sync::Mutex<Option<(&'a mut [PairState], &'a mut Part)>>;
 
 impl Part {
     fn clear(&mut self) {
@@ -546,12 +572,9 @@ impl NarrowPhase {
             let Some(e) = state.emitted else {
                 continue;
             };
-            let at = self
-                .bases
-                .get(e.part as usize)
-                .map(|&b| b as usize + e.first as usize);
-            let range = at.and_then(|at| Some(at..at.checked_add(e.count as usize)?));
-            let Some(range) = range.filter(|r| r.end <= self.slots.len().min(self.contacts.len()))
+            let Some(range) = e
+                .range(&self.bases)
+                .filter(|r| r.end <= self.slots.len().min(self.contacts.len()))
             else {
                 return Err(format!(
                     "pairs[{i}].emitted: contacts {} + {} of part {} are not in the list",
@@ -851,22 +874,18 @@ impl NarrowPhase {
             return sequential(self);
         }
         let mut rest = self.contacts.as_mut_slice();
-        let cells: [std::sync::Mutex<Option<&mut [BodyContact]>>; MAX_PARTS] =
-            std::array::from_fn(|_| std::sync::Mutex::new(None));
-        for (k, cell) in cells.iter().enumerate().take(parts) {
-            let (own, tail) = std::mem::take(&mut rest).split_at_mut(starts[k + 1] - starts[k]);
-            *cell.lock().unwrap_or_else(|e| e.into_inner()) = Some(own);
+        let mut runs: [&mut [BodyContact]; MAX_PARTS] = std::array::from_fn(|k| {
+            let len = if k < parts {
+                starts[k + 1] - starts[k]
+            } else {
+                0
+            };
+            let (own, tail) = std::mem::take(&mut rest).split_at_mut(len);
             rest = tail;
-        }
+            own
+        });
         let in_order = std::sync::atomic::AtomicBool::new(true);
-        runner.run(parts, &|k| {
-            let Some(cell) = cells.get(k) else {
-                return;
-            };
-            let mut guard = cell.lock().unwrap_or_else(|e| e.into_inner());
-            let Some(own) = guard.as_mut() else {
-                return;
-            };
+        run_parts(runner, &mut runs[..parts], &|k, own| {
             for i in first(k)..first(k + 1) {
                 let (index, impulse, preload) = point(i);
                 match index.checked_sub(starts[k]).and_then(|at| own.get_mut(at)) {
@@ -1023,21 +1042,11 @@ impl NarrowPhase {
         if count == 1 {
             self.parts[0].update(0, &mut self.pairs, &input, min_cos);
         } else {
-            let cells: [PartCell<'_>; MAX_PARTS] =
-                std::array::from_fn(|_| std::sync::Mutex::new(None));
-            for ((cell, states), part) in cells
-                .iter()
-                .zip(self.pairs.chunks_mut(per_part))
-                .zip(self.parts.iter_mut())
-            {
-                *cell.lock().unwrap_or_else(|e| e.into_inner()) = Some((states, part));
-            }
-            runner.run(count, &|i| {
-                let Some(cell) = cells.get(i) else {
-                    return;
-                };
-                let mut guard = cell.lock().unwrap_or_else(|e| e.into_inner());
-                if let Some((states, part)) = guard.as_mut() {
+            // Each part's pairs and outputs.
+            let mut each = self.pairs.chunks_mut(per_part).zip(self.parts.iter_mut());
+            let mut work: [_; MAX_PARTS] = std::array::from_fn(|_| each.next());
+            run_parts(runner, &mut work[..count], &|i, work| {
+                if let Some((states, part)) = work {
                     part.update(i as u32, states, &input, min_cos);
                 }
             });

@@ -221,9 +221,8 @@ const RECENT_RUNS: usize = 4;
 /// chosen by the clock").
 #[derive(Clone, Copy, Debug, Default)]
 struct ThreadChoice {
-    /// Cost per point (ns): one thread, the team; the least of `recent`.
-    cost: [Option<f64>; 2],
-    /// The last [`RECENT_RUNS`] counted costs per point of each mode (0: none yet), in a ring.
+    /// The last [`RECENT_RUNS`] counted costs per point (ns) of each mode, one thread and the
+    /// team (0: none yet), in a ring.
     recent: [[f64; RECENT_RUNS]; 2],
     /// Runs of each mode so far (saturating).
     runs: [u32; 2],
@@ -237,7 +236,7 @@ impl ThreadChoice {
 
     /// Whether the next step's substeps run on the team.
     fn use_team(&mut self) -> bool {
-        match self.cost {
+        match self.cost() {
             [None, _] => false,
             [_, None] => true,
             [Some(solo), Some(team)] => {
@@ -261,13 +260,17 @@ impl ThreadChoice {
             return;
         }
         let cost = time.as_nanos() as f64 / points as f64;
-        let recent = &mut self.recent[mode];
-        recent[self.runs[mode] as usize % RECENT_RUNS] = cost;
-        self.cost[mode] = recent
-            .iter()
-            .copied()
-            .filter(|&c| c > 0.0)
-            .min_by(f64::total_cmp);
+        self.recent[mode][self.runs[mode] as usize % RECENT_RUNS] = cost;
+    }
+
+    /// Each mode's cost per point (ns): the least of its recent runs, `None` before any.
+    fn cost(&self) -> [Option<f64>; 2] {
+        self.recent.map(|recent| {
+            recent
+                .into_iter()
+                .filter(|&c| c > 0.0)
+                .min_by(f64::total_cmp)
+        })
     }
 }
 
