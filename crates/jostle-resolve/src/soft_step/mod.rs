@@ -429,10 +429,10 @@ impl SoftStepResolver {
             if !(start.inv_mass > 0.0) || inertia == Mat3::ZERO {
                 continue;
             }
-            let inertia_now = gyroscopic::rotate_inertia(inertia, state.delta_rotation);
-            if gyroscopic::mismatch(inertia_now, *rows) <= gyroscopic::ROWS_MISMATCH {
+            if !gyroscopic::turned_off_rows(inertia, *rows, state.delta_rotation) {
                 continue;
             }
+            let inertia_now = gyroscopic::rotate_inertia(inertia, state.delta_rotation);
             let mass = 1.0 / start.inv_mass;
             let energy = |v: jostle_math::Vec3, w: jostle_math::Vec3, i: Mat3| {
                 0.5 * mass * v.length_squared() + 0.5 * w.dot(i * w)
