@@ -541,7 +541,7 @@ impl Batches {
             for (l, run) in batch_runs.iter_mut().enumerate().take(lanes) {
                 *run = self.runs[self.order[k + l] as usize];
             }
-            // Near horizontal: the key's bit 64 (`!side`) is clear.
+            // Near horizontal: the key's `SIDE_BIT` (`!side`) is clear.
             let side =
                 (0..lanes).all(|l| self.keys[self.order[k + l] as usize] & (1 << SIDE_BIT) == 0);
             self.push_batch(&batch_runs[..lanes], side);
