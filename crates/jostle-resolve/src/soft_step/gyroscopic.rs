@@ -99,7 +99,13 @@ pub fn turn_against(
     h: f32,
 ) -> Option<(Quat, Vec3)> {
     let rows = rows_inverse != Mat3::ZERO;
-    if rows && turned_off_rows(inertia, rows_inverse, before) {
+    // The bound's factor, once for both ends of the turn.
+    let spread = if rows {
+        spread(inertia, rows_inverse)
+    } else {
+        0.0
+    };
+    if rows && turned_off(inertia, rows_inverse, spread, before) {
         return None;
     }
     // The turned inertia R·I·Rᵀ is applied as a rotation of the vector into the step-start
@@ -127,7 +133,7 @@ pub fn turn_against(
         q = integrate_orientation(q, mid * piece);
         w = omega_at(q)?;
     }
-    if rows && turned_off_rows(inertia, rows_inverse, q) {
+    if rows && turned_off(inertia, rows_inverse, spread, q) {
         return None;
     }
     Some((q, w))
@@ -194,10 +200,19 @@ impl Inverse64 {
 /// spectral ones) plus that rounding. A body turning slowly within the step (most of them)
 /// is settled by the bound; the answer is the same either way.
 pub fn turned_off_rows(inertia: Mat3, rows_inverse: Mat3, q: Quat) -> bool {
+    turned_off(inertia, rows_inverse, spread(inertia, rows_inverse), q)
+}
+
+/// ‖I‖·‖I⁻¹‖ in Frobenius norms, the factor of [`turned_off_rows`]' bound.
+fn spread(inertia: Mat3, rows_inverse: Mat3) -> f32 {
     let norm = |m: Mat3| {
         (m.x_axis.length_squared() + m.y_axis.length_squared() + m.z_axis.length_squared()).sqrt()
     };
-    let spread = norm(inertia) * norm(rows_inverse);
+    norm(inertia) * norm(rows_inverse)
+}
+
+/// [`turned_off_rows`] with its bound's factor `spread` ([`spread`]) already taken.
+fn turned_off(inertia: Mat3, rows_inverse: Mat3, spread: f32, q: Quat) -> bool {
     // The rounding of I·I⁻¹ − 1 (about the condition number times f32's epsilon), with room.
     let rounding = spread * 1e-6 + 1e-3;
     if 4.0 * q.xyz().length() * spread + rounding <= ROWS_MISMATCH {
