@@ -1216,14 +1216,34 @@ fn update_pair(
     };
     let pose1 = c1.world_pose(b1);
     let pose2 = c2.world_pose(b2);
-    if !(pose1.is_finite() && pose2.is_finite()) {
+    // (Read from the bodies where the colliders sit at their centres of mass: the poses just
+    // built are written to memory in pieces, and reading them back whole stalls the store
+    // forward; `perf` put 17% of a resting pyramid's narrow phase on it, and in a loop of
+    // updates alone reading the bodies took 3–6% off each.)
+    let at_centres = c1.local_pose() == Pose::IDENTITY && c2.local_pose() == Pose::IDENTITY;
+    let finite = if at_centres {
+        b1.position.is_finite()
+            && b1.orientation.is_finite()
+            && b2.position.is_finite()
+            && b2.orientation.is_finite()
+    } else {
+        pose1.is_finite() && pose2.is_finite()
+    };
+    if !finite {
         // Non-finite state is the facade's to report; it must not reach parry.
         return false;
     }
     if !c1.groups.meets(&c2.groups) || filter.is_some_and(|f| !f(c1, c2)) {
         return false;
     }
-    let pos12 = pose1.inv_mul(&pose2);
+    let pos12 = if at_centres {
+        relative_pose((b1.position, b1.orientation), (b2.position, b2.orientation))
+    } else {
+        relative_pose(
+            (pose1.translation, pose1.rotation),
+            (pose2.translation, pose2.rotation),
+        )
+    };
     if c1.sensor || c2.sensor {
         // No contact: only whether they overlap (an unsupported pair of shapes never
         // does).
@@ -1562,6 +1582,15 @@ fn pair_prediction(
     } else {
         prediction
     }
+}
+
+/// `pose1.inv_mul(pose2)` from the poses' parts: the pose of frame 2 in frame 1, inlined (out
+/// of line, `inv_mul` read its arguments back from memory just after they were written in
+/// narrower pieces, a stalled store forward).
+#[inline(always)]
+fn relative_pose((t1, r1): (Vec3, Quat), (t2, r2): (Vec3, Quat)) -> Pose {
+    let inv_rot1 = r1.inverse();
+    Pose::from_parts(inv_rot1 * (t2 - t1), inv_rot1 * r2)
 }
 
 /// The relative pose of a manifold's two sub-shapes (compound parts carry their own frames).
