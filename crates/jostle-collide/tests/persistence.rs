@@ -1,9 +1,10 @@
-//! Manifold persistence: warm-start impulses matched by feature id, and manifold reuse.
+//! Manifold persistence: warm-start impulses matched by feature id, manifold reuse, and pairs
+//! kept apart without a contact query.
 
 mod common;
 
 use common::*;
-use jostle_collide::ShapeDesc;
+use jostle_collide::{NarrowPhase, ShapeDesc};
 use jostle_math::{Quat, Vec3};
 
 /// Stores a distinct impulse per contact, moves `body` by `delta`, updates, and checks every
@@ -310,4 +311,69 @@ fn points_stored_in_parts_are_stored_as_one_after_the_other() {
             assert_eq!(scene.contacts()[2].preload, 0.5);
         }
     }
+}
+
+/// Two convex shapes whose bounding boxes overlap while the shapes are apart: the contact
+/// query of such a pair is skipped while the direction that last separated them still keeps
+/// them further apart than the prediction distance (`NarrowStats::kept_apart`). Every skip is
+/// checked against a narrow phase without history, which must find no contact there either;
+/// each path ends in contact, which must then be found.
+#[test]
+fn a_pair_kept_apart_has_no_contact_a_fresh_query_would_find() {
+    let shapes = [
+        ShapeDesc::Cuboid {
+            half_extents: Vec3::new(0.5, 0.4, 0.3),
+        },
+        ShapeDesc::Ball { radius: 0.4 },
+        ShapeDesc::Capsule {
+            half_height: 0.3,
+            radius: 0.2,
+        },
+        ShapeDesc::Cylinder {
+            half_height: 0.3,
+            radius: 0.35,
+        },
+        hull_prism(),
+    ];
+    let diagonal = Vec3::new(1.0, 0.9, 0.8).normalize();
+    let mut skipped = 0;
+    for (i, a) in shapes.iter().enumerate() {
+        for (j, b) in shapes.iter().enumerate() {
+            let mut scene = Scene::new();
+            scene.dynamic(a, Vec3::ZERO);
+            let body = scene.add(b, diagonal * 1.6, Quat::IDENTITY, false).0;
+            let spin = Quat::from_axis_angle(Vec3::new(0.3, 1.0, -0.5).normalize(), 0.04);
+            let mut touched = false;
+            for step in 0..150 {
+                // Closer along the diagonal each step, wobbling sideways and turning.
+                let wobble = Vec3::new(0.0, (step as f32 * 0.3).sin(), 0.0) * 2e-3;
+                scene.move_by(body, -diagonal * 0.008 + wobble);
+                scene.turn_by(body, spin);
+                let stats = scene.step();
+                let mut fresh = NarrowPhase::new();
+                fresh.update(
+                    scene.broad.pairs(),
+                    &scene.colliders,
+                    &scene.bodies,
+                    &scene.settings,
+                );
+                if stats.kept_apart > 0 {
+                    skipped += 1;
+                    assert!(
+                        fresh.contacts().is_empty(),
+                        "shapes {i} and {j}, step {step}: skipped a pair with {} contacts",
+                        fresh.contacts().len()
+                    );
+                    assert!(scene.contacts().is_empty());
+                }
+                touched |= !scene.contacts().is_empty();
+            }
+            assert!(touched, "shapes {i} and {j} never touched");
+        }
+    }
+    // The skip happens (for most of the 25 paths, for many steps of each).
+    assert!(
+        skipped > 500,
+        "{skipped} skipped updates (1,060 when written)"
+    );
 }
