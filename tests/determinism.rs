@@ -232,3 +232,31 @@ fn a_snapshot_with_broken_islands_is_refused() {
     assert!(err.contains("islands") && err.contains("island 7"), "{err}");
     assert!(World::from_snapshot(Snapshot::parse(&text, "good").unwrap()).is_ok());
 }
+
+/// A snapshot whose pair with contact points claims a direction that keeps it apart (which
+/// would skip its contact query and leave its points unrefreshed) is refused, naming the pair.
+#[test]
+fn a_snapshot_keeping_a_touching_pair_apart_is_refused() {
+    let s = scene("pyramid20.ron");
+    let mut world = s.build().unwrap();
+    world.step(DT).unwrap();
+    let path = std::env::temp_dir().join(format!("jostle-apart-snapshot-{}", std::process::id()));
+    world.snapshot(&s.name, DT).save(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::remove_file(&path).ok();
+    // Every pair of the resting pyramid touches: the first pair's record gets a direction.
+    assert!(
+        text.contains("apart: None"),
+        "no pair records its direction"
+    );
+    let bad = text.replacen("apart: None", "apart: Some((0.0, 1.0, 0.0))", 1);
+    let err = match World::from_snapshot(Snapshot::parse(&bad, "bad").unwrap()) {
+        Ok(_) => panic!("a touching pair kept apart was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        err.contains("apart") && err.contains("contact points"),
+        "{err}"
+    );
+    assert!(World::from_snapshot(Snapshot::parse(&text, "good").unwrap()).is_ok());
+}

@@ -516,12 +516,18 @@ impl NarrowPhase {
                 ));
             };
             let limit = max_impulse(c1, c2);
-            if let Some(axis) = state.apart
-                && !(axis.is_finite() && (axis.length() - 1.0).abs() < 1e-3)
-            {
-                return Err(format!(
-                    "pairs[{i}].apart: must be a unit vector, got {axis}"
-                ));
+            if let Some(axis) = state.apart {
+                if !(axis.is_finite() && (axis.length() - 1.0).abs() < 1e-3) {
+                    return Err(format!(
+                        "pairs[{i}].apart: must be a unit vector, got {axis}"
+                    ));
+                }
+                // Only a pair without points keeps a direction (`update_pair` relies on it).
+                if state.manifolds.iter().any(|m| !m.points.is_empty()) {
+                    return Err(format!(
+                        "pairs[{i}].apart: a pair with contact points keeps no direction"
+                    ));
+                }
             }
             for (j, manifold) in state.manifolds.iter().enumerate() {
                 let at = |k: usize, field: &str| {
@@ -1311,14 +1317,22 @@ fn update_pair(
             .iter()
             .filter(|m| !m.points.is_empty())
             .count();
-    } else if state.manifolds.iter().all(|m| m.points.is_empty())
-        && state.apart.is_some_and(|axis| {
-            gap_along(c1, c2, &pos12, axis).is_some_and(|gap| gap > prediction + APART_SLACK)
-        })
-    {
+    } else if state.apart.is_some_and(|axis| {
+        gap_along(c1, c2, &pos12, axis).is_some_and(|gap| gap > prediction + APART_SLACK)
+    }) {
         // Still apart along the same direction, by more than the prediction distance: no
-        // contact query can find a point, and the pair keeps its empty manifolds.
+        // contact query can find a point. The pair keeps its empty manifolds (a kept direction
+        // is only set by a query that found no point, and only a query adds points), and with
+        // nothing to emit they are not even read (in a rain, the read was a cache miss a pair).
+        debug_assert!(
+            state.manifolds.iter().all(|m| m.points.is_empty()),
+            "a pair kept apart with contact points"
+        );
         out.stats.kept_apart += 1;
+        *out.any_threshold |=
+            c1.force_event_threshold.is_some() || c2.force_event_threshold.is_some();
+        state.emitted = None;
+        return true;
     } else {
         compute(state, c1, c2, &pos12, prediction, out.old_points);
     }
