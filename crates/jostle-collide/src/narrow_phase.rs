@@ -1020,16 +1020,34 @@ impl NarrowPhase {
             // where the pair is not new. (Where the pairs are the last update's, each state
             // is updated where it is: moving every state into a new list cost a memmove per
             // pair.)
+            //
+            // Runs of states that stay are moved in one `extend` each, each state read once and
+            // written once; through a peeking iterator it was copied more often, and a rain's
+            // pair list changes every step (5,800 states of 240 bytes for 1,000 bodies: replayed,
+            // 1.51 → 1.39–1.41 ms an update).
             let mut old_pairs = std::mem::replace(&mut self.pairs, std::mem::take(&mut self.spare));
             self.pairs.clear();
             self.pairs.reserve(pairs.len());
-            let mut old = old_pairs.drain(..).peekable();
-            for &pair in pairs.iter() {
-                while old.next_if(|s| s.pair < pair).is_some() {}
-                let state = old
-                    .next_if(|s| s.pair == pair)
-                    .unwrap_or_else(|| PairState::new(pair));
-                self.pairs.push(state);
+            let mut old = old_pairs.drain(..);
+            let mut next = 0;
+            while let Some(&pair) = pairs.get(next) {
+                // Pairs no longer listed are dropped.
+                let gone = old.as_slice().iter().take_while(|s| s.pair < pair).count();
+                old.by_ref().take(gone).for_each(drop);
+                // The run of listed pairs that were listed before, in order.
+                let kept = old
+                    .as_slice()
+                    .iter()
+                    .zip(&pairs[next..])
+                    .take_while(|(s, p)| s.pair == **p)
+                    .count();
+                if kept > 0 {
+                    self.pairs.extend(old.by_ref().take(kept));
+                    next += kept;
+                } else {
+                    self.pairs.push(PairState::new(pair));
+                    next += 1;
+                }
             }
             drop(old);
             self.spare = old_pairs;
