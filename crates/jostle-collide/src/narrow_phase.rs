@@ -1798,6 +1798,10 @@ fn depth_bound(c1: &Collider, c2: &Collider, pos12: &Pose) -> Option<f32> {
     Some((max1 - min2).min(max2 - min1))
 }
 
+/// How far (m) a reported depth may exceed the overlap along the line of centres before
+/// [`cross_check_depth`] repeats the query (besides 1% of that overlap).
+const DEPTH_CHECK_TOLERANCE: f32 = 1e-3;
+
 /// Works around parry 0.31's GJK/EPA on exactly aligned convex polytopes and cylinders (a stack
 /// of identical hulls or cylinders): in one argument order it returns a diagonal normal and a
 /// depth of ~0.7 m for a 1 cm overlap, in the other the right answer. And on manifolds
@@ -1808,6 +1812,12 @@ fn depth_bound(c1: &Collider, c2: &Collider, pos12: &Pose) -> Option<f32> {
 /// against the overlap along the line of centres, an upper bound of the true depth; only
 /// when it exceeds it is the query repeated from no manifold, then with the shapes exchanged,
 /// and the shallowest answer kept (the depth is the *smallest* separating translation).
+///
+/// A depth within the check's absolute tolerance ([`DEPTH_CHECK_TOLERANCE`]) is not checked:
+/// it passes for any bound of 0 or more, that is whenever the shapes overlap along the line of
+/// centres at all, and the errors the check is for are tenths of a metre. In two rains of
+/// 1,000 bodies, 85% of the checks were of such depths and none of them failed (960,000
+/// checks); each took four support points, 6% of the rains' narrow phase.
 fn cross_check_depth(
     state: &mut PairState,
     c1: &Collider,
@@ -1816,13 +1826,13 @@ fn cross_check_depth(
     prediction: f32,
 ) {
     let depth = max_penetration(&state.manifolds);
-    if depth <= 0.0 {
+    if depth <= DEPTH_CHECK_TOLERANCE {
         return;
     }
     let Some(bound) = depth_bound(c1, c2, pos12) else {
         return;
     };
-    let plausible = |depth: f32| depth <= bound + 1e-3 + 0.01 * bound.abs();
+    let plausible = |depth: f32| depth <= bound + DEPTH_CHECK_TOLERANCE + 0.01 * bound.abs();
     if plausible(depth) {
         return;
     }
