@@ -162,18 +162,27 @@ fn snapshot_formats_are_read_from_the_oldest_supported_and_later_ones_refused() 
     }
 }
 
+/// The snapshot text of the asset `file` after `steps` steps, written to a temporary file
+/// (named with `tag`) and read back.
+fn snapshot_text(file: &str, steps: usize, tag: &str) -> String {
+    let s = scene(file);
+    let mut world = s.build().unwrap();
+    for _ in 0..steps {
+        world.step(DT).unwrap();
+    }
+    let path = std::env::temp_dir().join(format!("jostle-{tag}-snapshot-{}", std::process::id()));
+    world.snapshot(&s.name, DT).save(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::remove_file(&path).ok();
+    text
+}
+
 /// A snapshot edited by hand into settings a scene file would refuse is refused too, naming
 /// the setting, instead of running with them (`substeps: 0`, NaN gravity) or stopping the
 /// process on an assertion in parry (a negative `collide.prediction`) (issue 16).
 #[test]
 fn a_snapshot_with_invalid_settings_is_refused_by_name() {
-    let s = scene("box_drop.ron");
-    let mut world = s.build().unwrap();
-    world.step(DT).unwrap();
-    let path = std::env::temp_dir().join(format!("jostle-bad-snapshot-{}", std::process::id()));
-    world.snapshot(&s.name, DT).save(&path).unwrap();
-    let text = std::fs::read_to_string(&path).unwrap();
-    std::fs::remove_file(&path).ok();
+    let text = snapshot_text("box_drop.ron", 1, "bad");
     assert!(World::from_snapshot(Snapshot::parse(&text, "good").unwrap()).is_ok());
     let edits = [
         ("substeps: 8", "substeps: 0", "settings.resolver.substeps"),
@@ -212,15 +221,7 @@ fn a_snapshot_with_invalid_settings_is_refused_by_name() {
 /// `crates/jostle-sleep/src/islands.rs` indexed the island list unchecked).
 #[test]
 fn a_snapshot_with_broken_islands_is_refused() {
-    let s = scene("pyramid20.ron");
-    let mut world = s.build().unwrap();
-    for _ in 0..100 {
-        world.step(DT).unwrap();
-    }
-    let path = std::env::temp_dir().join(format!("jostle-islands-snapshot-{}", std::process::id()));
-    world.snapshot(&s.name, DT).save(&path).unwrap();
-    let text = std::fs::read_to_string(&path).unwrap();
-    std::fs::remove_file(&path).ok();
+    let text = snapshot_text("pyramid20.ron", 100, "islands");
     let at = text.find("sleeping_of: [").expect("an islands section");
     let (head, tail) = text.split_at(at);
     assert!(tail.contains("Some(0)"), "nothing asleep after 100 steps");
@@ -237,13 +238,7 @@ fn a_snapshot_with_broken_islands_is_refused() {
 /// would skip its contact query and leave its points unrefreshed) is refused, naming the pair.
 #[test]
 fn a_snapshot_keeping_a_touching_pair_apart_is_refused() {
-    let s = scene("pyramid20.ron");
-    let mut world = s.build().unwrap();
-    world.step(DT).unwrap();
-    let path = std::env::temp_dir().join(format!("jostle-apart-snapshot-{}", std::process::id()));
-    world.snapshot(&s.name, DT).save(&path).unwrap();
-    let text = std::fs::read_to_string(&path).unwrap();
-    std::fs::remove_file(&path).ok();
+    let text = snapshot_text("pyramid20.ron", 1, "apart");
     // Every pair of the resting pyramid touches: the first pair's record gets a direction.
     assert!(
         text.contains("apart: None"),
