@@ -1787,15 +1787,11 @@ fn max_penetration(manifolds: &[Manifold]) -> f32 {
 /// joining their origins (the depth is the overlap along the *best* axis, so along any axis the
 /// overlap bounds it from above). `None` when a shape has no support map or the origins meet.
 fn depth_bound(c1: &Collider, c2: &Collider, pos12: &Pose) -> Option<f32> {
-    let s1 = c1.shape.as_support_map()?;
-    let s2 = c2.shape.as_support_map()?;
     let u = pos12.translation.try_normalize()?;
-    // Extent of shape 1 along +u, and of shape 2 along −u, both in shape 1's frame.
-    let max1 = u.dot(s1.local_support_point(u));
-    let min2 = u.dot(s2.support_point(pos12, -u));
-    let max2 = u.dot(s2.support_point(pos12, u));
-    let min1 = u.dot(s1.local_support_point(-u));
-    Some((max1 - min2).min(max2 - min1))
+    // The overlap along either direction of the line is minus the gap along it.
+    let along = -gap_along(c1, c2, pos12, u)?;
+    let against = -gap_along(c1, c2, pos12, -u)?;
+    Some(along.min(against))
 }
 
 /// How far (m) a reported depth may exceed the overlap along the line of centres before
