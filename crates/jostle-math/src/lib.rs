@@ -18,4 +18,4 @@ pub use basis::{contact_basis, skew};
 pub use glam;
 pub use glam::{Mat3, Quat, Vec3};
 pub use inertia::{InertiaShape, inverse_principal, world_inverse_inertia};
-pub use rotation::integrate_orientation;
+pub use rotation::{advance_orientation, integrate_orientation};

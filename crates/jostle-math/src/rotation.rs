@@ -10,14 +10,21 @@ use glam::{Quat, Vec3};
 /// 0.03%. Used both by integration (rotation = ω·dt) and by nonlinear projection.
 #[inline]
 pub fn integrate_orientation(q: Quat, rotation: Vec3) -> Quat {
+    advance_orientation(q, rotation).normalize()
+}
+
+/// [`integrate_orientation`] before its normalisation: q + ½·(0, rotation)·q, whose length
+/// is 1 + O(|rotation|²) for a unit `q`. For a caller that reads the result only through
+/// products that divide its length out.
+#[inline]
+pub fn advance_orientation(q: Quat, rotation: Vec3) -> Quat {
     let spin = Quat::from_xyzw(rotation.x, rotation.y, rotation.z, 0.0) * q;
-    let out = Quat::from_xyzw(
+    Quat::from_xyzw(
         q.x + 0.5 * spin.x,
         q.y + 0.5 * spin.y,
         q.z + 0.5 * spin.z,
         q.w + 0.5 * spin.w,
-    );
-    out.normalize()
+    )
 }
 
 #[cfg(test)]

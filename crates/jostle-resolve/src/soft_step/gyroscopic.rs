@@ -13,7 +13,7 @@
 //! substep and kept energy to 0.02% at 10 rad/s, but at 1000 rad/s (2 rad per substep) a
 //! free box lost 75% of |L| in 2 s (benches/RESULTS.md, "Spin at any rate").
 
-use jostle_math::{Mat3, Quat, Vec3, integrate_orientation};
+use jostle_math::{Mat3, Quat, Vec3, advance_orientation, integrate_orientation};
 
 /// The inertia tensor I = (world inverse inertia)⁻¹ when the inverse is invertible, else
 /// `None` (a body with locked rotation axes gets no gyroscopic term).
@@ -128,7 +128,9 @@ pub fn turn_against(
     for _ in 0..pieces as u32 {
         let mut mid = w;
         for _ in 0..MIDPOINT_ITERATIONS {
-            mid = omega_at(advanced(q, mid * (0.5 * piece)))?;
+            // The midpoint's orientation is read only through `turned`, which divides its
+            // length out: not normalised (two of every piece's three square roots).
+            mid = omega_at(advance_orientation(q, mid * (0.5 * piece)))?;
         }
         q = integrate_orientation(q, mid * piece);
         w = omega_at(q)?;
@@ -137,20 +139,6 @@ pub fn turn_against(
         return None;
     }
     Some((q, w))
-}
-
-/// [`integrate_orientation`] without its normalisation: the midpoint's orientation is only
-/// read through [`turned`], which divides its length out, so normalising it (a square root and
-/// a division, two of every piece's three) changed nothing but the rounding.
-#[inline]
-fn advanced(q: Quat, rotation: Vec3) -> Quat {
-    let spin = Quat::from_xyzw(rotation.x, rotation.y, rotation.z, 0.0) * q;
-    Quat::from_xyzw(
-        q.x + 0.5 * spin.x,
-        q.y + 0.5 * spin.y,
-        q.z + 0.5 * spin.z,
-        q.w + 0.5 * spin.w,
-    )
 }
 
 /// R·M·Rᵀ·`v` with R the rotation of `q` and M·u = `m(u)`, through the quaternion: q·v·q̄ is
