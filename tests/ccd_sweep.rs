@@ -9,12 +9,20 @@
 //!   5 cm/s (a body CCD puts back at the same pose step after step). One step at the same pose
 //!   is a stop at the very start of the step (the body was within the CCD slop of the surface)
 //!   whose impact the next step's contacts resolve: counted as a pause, not a freeze;
-//! - energy: its mechanical energy ½mv² + ½ωᵀIω + m·g·y above the start's.
+//! - energy: its energy above the start's, counted as the integrator keeps it:
+//!   ½mv² + ½ωᵀIω − m·g·x + ½m·h·g·v, with h the resolver's integration step (dt for the
+//!   Millington resolver, dt / substeps for the soft step). Semi-implicit Euler keeps exactly
+//!   this constant in free flight; the plain mechanical energy ½mv² + ½ωᵀIω − m·g·x falls by
+//!   ½m|g|²h² at every integration step, and its value at the end of a step is m·|g|·h·|v_y|
+//!   higher on the way up than at the same height and speed on the way down, so that a ball
+//!   bouncing at e = 1 back to the very apex it fell from seems to gain that much at every
+//!   bounce (benches/RESULTS.md, "Bounces bounded by the energy the integrator keeps").
 //!
 //! The CI part asserts that no shot goes through or freezes, for both resolvers, and that no
-//! soft-step shot gains energy. `every_shot_keeps_its_energy_in_both_resolvers` (ignored)
-//! asserts the energy for the Millington resolver too, which does not hold yet: it prints
-//! every shot that fails (benches/RESULTS.md, "CCD: no freeze, no tunnel").
+//! shot of the first [`ENERGY_SHOTS`] gains energy, for both.
+//! `every_shot_keeps_its_energy_in_both_resolvers` (ignored) runs the whole family (`CCD_SHOTS`
+//! shots per resolver) and prints every shot that fails; a few still gain a little (issue 16
+//! item 1 is open).
 
 use jostle::{BodyDesc, BodyHandle, Quat, ResolverChoice, ShapeDesc, Vec3, World, WorldSettings};
 mod common;
@@ -178,8 +186,16 @@ fn run(resolver: &ResolverChoice, shot: &Shot) -> Outcome {
                 .with_material(0.5, shot.restitution),
         )
         .expect("shot");
-    let energy =
-        |world: &World| world.kinetic_energy() - f64::from(g) * position(world, body).y as f64;
+    // The integrator's energy (module doc), its gravity term with the integration step.
+    let h = match resolver {
+        ResolverChoice::Millington(_) => DT,
+        ResolverChoice::SoftStep(s) => DT / s.substeps.max(1) as f32,
+    };
+    let energy = |world: &World| {
+        let b = world.body(body).expect("shot");
+        world.kinetic_energy() - f64::from(g) * f64::from(b.position.y)
+            + 0.5 * f64::from(h * g * b.linear_velocity.y)
+    };
     let start = energy(&world);
     let mut outcome = Outcome::default();
     let mut before = pose(&world, body);
@@ -246,23 +262,29 @@ fn no_shot_goes_through_the_floor_or_freezes() {
     }
 }
 
+/// Shots per resolver of the CI part's energy test. (Before the Millington resolver's bounces
+/// were bounded by the integrator's energy, its shots 51, 74 and 104 gained 0.4%, 0.8% and 0.2%.)
+const ENERGY_SHOTS: u64 = 120;
+
 #[test]
-fn no_soft_step_shot_gains_energy() {
-    let resolver = ResolverChoice::default();
-    for i in 0..SHOTS {
-        let shot = Shot::new(i);
-        let outcome = run(&resolver, &shot);
-        assert!(
-            outcome.energy_gain <= ENERGY_ROUNDING,
-            "shot {i} gained {:.2}% of its energy: {shot:?}",
-            100.0 * outcome.energy_gain
-        );
+fn no_shot_gains_energy() {
+    for (name, resolver) in resolvers() {
+        for i in 0..ENERGY_SHOTS {
+            let shot = Shot::new(i);
+            let outcome = run(&resolver, &shot);
+            assert!(
+                outcome.energy_gain <= ENERGY_ROUNDING,
+                "{name}, shot {i} gained {:.2}% of its energy: {shot:?}",
+                100.0 * outcome.energy_gain
+            );
+        }
     }
 }
 
-/// The whole of item 1 over 240 shots per resolver; prints every shot that fails.
+/// The whole of item 1 over `CCD_SHOTS` shots per resolver (240 unless set); prints every shot
+/// that fails.
 #[test]
-#[ignore = "open (issue 16 item 1): Millington bounces at e = 1 gain up to 7.7% of 2,000 shots (gravity on the way out of a bounce)"]
+#[ignore = "open (issue 16 item 1): of 8,000 shots per resolver a few gain up to 0.4%"]
 fn every_shot_keeps_its_energy_in_both_resolvers() {
     // `CCD_SHOTS` sets the count (default 240).
     let shots: u64 = std::env::var("CCD_SHOTS")

@@ -16,8 +16,8 @@
 //! would have, which shifts the apex by up to |v|·dt and the energy at an apex by up to
 //! m·g·|v|·dt, with |v| = √(2·g·h) the impact speed from the drop height h: 1.3% at 10 m, 4.3%
 //! at 1 m and 13.5% at 0.1 m. Measured maxima over the family (printed with `--nocapture`):
-//! the highest apex is 0.983 of the drop height (soft step) and 0.997 (Millington), the
-//! largest energy at an apex 0.998 of the start (soft step) and 1.029 (Millington, the 0.1 m
+//! the highest apex is 0.988 of the drop height (soft step) and 0.997 (Millington), the
+//! largest energy at an apex 0.9995 of the start (soft step) and 1.002 (Millington, a 10 m
 //! plank).
 
 mod common;

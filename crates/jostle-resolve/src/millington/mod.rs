@@ -290,7 +290,7 @@ impl MillingtonResolver {
         );
         stats.velocity_residual = self.scratch.residual;
         self.work[1] = std::mem::take(&mut self.scratch.work);
-        bound_bounce_energy(&self.bounce_marks, &self.before_velocity, bodies);
+        bound_bounce_energy(&self.bounce_marks, &self.before_velocity, bodies, dt);
         for (c, p) in contacts.iter_mut().zip(&self.prepared) {
             c.impulse = p.impulse;
             c.penetration = p.penetration;
@@ -499,10 +499,9 @@ fn mark_bounces(
 }
 
 /// The energy bound of a bounce off immovable bodies: a body whose contacts this step are
-/// all with bodies that cannot move, one of them bouncing, leaves the velocity pass with no
-/// more kinetic energy than it entered it with; where it has more, the pass's change to its
-/// velocities is scaled back to the largest fraction that meets the bound (at least the
-/// inelastic half of it for e ≤ 1, so no contact is left approaching).
+/// all with bodies that cannot move, one of them bouncing, leaves the step with no more
+/// energy than it brought into it; where it would leave with more, the pass's change to its
+/// velocities is scaled back to the largest fraction that meets the bound.
 ///
 /// Why: each point bounces at −e times its own closing speed (Newton's rule, point by
 /// point). For a body striking with several points at once at different speeds (a
@@ -510,10 +509,26 @@ fn mark_bounces(
 /// than the body brought: a 1 × 0.04 × 1 m plate hitting a wall at 20 m/s with e = 1
 /// left with 28% more (benches/RESULTS.md, "CCD: no freeze, no tunnel"). The soft step
 /// bounds its restitution pass the same way.
+///
+/// The energy is the one semi-implicit Euler keeps in free flight: with h the step,
+/// E = ½m|v|² + ½ωᵀIω − m·g·x + ½m·h·g·v, which stays constant step after step under
+/// gravity alone (the plain ½m|v|² − m·g·x falls by ½m|g·h|² a step, and its value at the
+/// end of a step swings by m·|g|·h·|v_y| between the way down and the way up, so a ball
+/// bouncing at e = 1 back to the same apex seems to gain that much at every bounce). This
+/// resolver adds the step's gravity g·h to the velocities before the pass (`before` holds
+/// them) and then moves the bodies by what the pass leaves, and over such a step E does not
+/// grow exactly when the kinetic energy of the velocities less half the step's gravity,
+/// ½m|v − ½g·h|² + ½ωᵀIω, does not grow across the pass: that is the bound. A ball bouncing
+/// straight at e = 1 meets it exactly (the micro-collision rule's −e·(v − v_acc) is its
+/// mirror image); a plate landing on a corner, bounded on its kinetic energy alone, kept
+/// nearly all of the kinetic energy the step's gravity had added (the corner's impulse takes
+/// out only the part its small effective mass carries) and gained up to 2.2% of its energy in
+/// a bounce (benches/RESULTS.md, "Bounces bounded by the energy the integrator keeps").
 fn bound_bounce_energy(
     marks: &[u8],
     before: &[(jostle_math::Vec3, jostle_math::Vec3)],
     bodies: &mut [SolverBody],
+    dt: f32,
 ) {
     for (i, &mark) in marks.iter().enumerate() {
         if mark != BOUNCES_ON_FIXED {
@@ -533,11 +548,13 @@ fn bound_bounce_energy(
             jostle_math::Mat3::ZERO
         };
         let (dv, dw) = (body.linear_velocity - v0, body.angular_velocity - w0);
-        let allowed = 0.5 * mass * v0.length_squared() + 0.5 * w0.dot(inertia * w0);
+        // The velocities before the pass less half the step's gravity (see above).
+        let start = v0 - 0.5 * dt * body.last_acceleration;
+        let allowed = 0.5 * mass * start.length_squared() + 0.5 * w0.dot(inertia * w0);
         let Some(s) = crate::energy::bounded_fraction(
             mass,
             inertia,
-            (v0, w0),
+            (start, w0),
             (dv, dw),
             allowed,
             allowed * 1e-6,
