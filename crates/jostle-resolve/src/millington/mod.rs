@@ -541,12 +541,8 @@ fn bound_bounce_energy(
             continue;
         }
         let mass = 1.0 / body.inv_mass;
-        let det = body.inv_inertia.determinant();
-        let inertia = if det.is_finite() && det > 0.0 {
-            body.inv_inertia.inverse()
-        } else {
-            jostle_math::Mat3::ZERO
-        };
+        let inertia =
+            crate::energy::inertia_of(body.inv_inertia).unwrap_or(jostle_math::Mat3::ZERO);
         let (dv, dw) = (body.linear_velocity - v0, body.angular_velocity - w0);
         // The velocities before the pass less half the step's gravity (see above).
         let start = v0 - 0.5 * dt * body.last_acceleration;

@@ -16,14 +16,11 @@
 use jostle_math::{Mat3, Quat, Vec3, advance_orientation, integrate_orientation};
 
 /// The inertia tensor I = (world inverse inertia)⁻¹ when the inverse is invertible, else
-/// `None` (a body with locked rotation axes gets no gyroscopic term).
+/// `None` (a body with locked rotation axes gets no gyroscopic term). Inverted in f64: in
+/// f32 a needle's inertia came out 2·10⁻³ off in energy, and its bounces gained that much
+/// (benches/RESULTS.md, "Bounces bounded by the energy the integrator keeps").
 pub fn inertia_of(inv_inertia: Mat3) -> Option<Mat3> {
-    let det = inv_inertia.determinant();
-    if !(det.is_finite() && det > 0.0) {
-        return None;
-    }
-    let inertia = inv_inertia.inverse();
-    inertia.is_finite().then_some(inertia)
+    crate::energy::inertia_of(inv_inertia)
 }
 
 /// Relative anisotropy below which [`is_isotropic`] calls an inertia the same about every
