@@ -793,8 +793,11 @@ fn preload_update(manifold: solve::ManifoldEnd, rate: f32, target: f32, dt: f32)
 
 /// Fewest batches for which a step's substeps may run on more than one thread: below, the
 /// stages are too short for the threads' hand-overs to pay. From there the clock decides
-/// (`ThreadChoice`).
-pub const PARALLEL_MIN_BATCHES: usize = 128;
+/// (`ThreadChoice`). Measured on two cores with planar pyramids of 12 to 28 rows (29 to 149
+/// batches), the best of five runs at two threads against one: the same time at 29–50
+/// batches, a fifth less from 77 (the 20-row pyramid) on (benches/RESULTS.md, "The team from
+/// 32 batches"; it was 128 while the team's stages cost more).
+pub const PARALLEL_MIN_BATCHES: usize = 32;
 
 /// Mass ratio of a manifold's two movable bodies from which both keep their warm start
 /// point by point in every substep ([`body_state::EXACT_WARM`]) instead of carrying it
