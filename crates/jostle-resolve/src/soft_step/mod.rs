@@ -641,13 +641,15 @@ trait Staged: Sync {
 /// Runs `work` on `team` with `threads` threads: first on a [`Plan`], which learns its
 /// stages into `plan`, then on the team reset for them.
 fn run_on_team(team: &mut Team, plan: &mut Vec<team::Parts>, threads: usize, work: &impl Staged) {
+    // The plan's stages go into `plan`'s own storage: no allocation once it has grown.
+    let mut stages = std::mem::take(plan);
+    stages.clear();
     let planned = Plan {
         threads,
-        stages: Default::default(),
+        stages: std::cell::RefCell::new(stages),
     };
     work.run(&planned);
-    plan.clear();
-    plan.append(&mut planned.stages.borrow_mut());
+    *plan = planned.stages.into_inner();
     team.reset(threads, plan);
     team::run(team, |member| work.run(member));
 }
@@ -1203,13 +1205,14 @@ impl Resolver for SoftStepResolver {
                 },
             };
             if threads > 1 {
+                let mut stages = std::mem::take(&mut self.plan);
+                stages.clear();
                 let plan = Plan {
                     threads,
-                    stages: Default::default(),
+                    stages: std::cell::RefCell::new(stages),
                 };
                 work.run(&plan, &Timing::default());
-                self.plan.clear();
-                self.plan.append(&mut plan.stages.borrow_mut());
+                self.plan = plan.stages.into_inner();
                 self.team.reset(threads, &self.plan);
                 // The first thread's times: each stage's wall time, waits included.
                 let times = std::sync::Mutex::new([Duration::ZERO; 3]);
