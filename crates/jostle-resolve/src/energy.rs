@@ -9,29 +9,60 @@
 
 use jostle_math::{Mat3, Vec3};
 
-/// The inertia tensor I = (world inverse inertia)⁻¹, inverted in f64, when the inverse is
-/// invertible, else `None`. Inverted in f32, the inertia of a needle's world inverse inertia
-/// (principal moments 1 : 1250) was off by about 10⁻³ of its energy, which the bounds below
-/// then let a bounce gain.
+/// The inertia tensor I = (world inverse inertia)⁻¹, inverted in f64 ([`Inverse64`]) and
+/// rounded to f32 once, when the inverse is positive definite, else `None`. Inverted in f32,
+/// the inertia of a needle's world inverse inertia (principal moments 1 : 1250) was off by
+/// about 10⁻³ of its energy, which the bounds below then let a bounce gain.
 pub(crate) fn inertia_of(inv_inertia: Mat3) -> Option<Mat3> {
-    let m = inv_inertia.to_cols_array().map(f64::from);
-    // Entry (row, column) of the column-major array, and its cofactor (cyclic indices give
-    // the signs).
-    let at = |r: usize, c: usize| m[c * 3 + r];
-    let cofactor = |r: usize, c: usize| {
-        let (r1, r2, c1, c2) = ((r + 1) % 3, (r + 2) % 3, (c + 1) % 3, (c + 2) % 3);
-        at(r1, c1) * at(r2, c2) - at(r1, c2) * at(r2, c1)
-    };
-    let det: f64 = (0..3).map(|c| at(0, c) * cofactor(0, c)).sum();
-    if !(det.is_finite() && det > 0.0) {
-        return None;
-    }
-    // (I⁻¹)⁻¹ at (row, column) is cofactor(column, row) / det.
-    let inertia = Mat3::from_cols_array(&std::array::from_fn(|k| {
-        let (c, r) = (k / 3, k % 3);
-        (cofactor(c, r) / det) as f32
-    }));
+    let inverse = Inverse64::of(inv_inertia).filter(|i| i.det > 0.0)?;
+    let inertia = Mat3::from_cols(
+        inverse.times(Vec3::X),
+        inverse.times(Vec3::Y),
+        inverse.times(Vec3::Z),
+    );
     inertia.is_finite().then_some(inertia)
+}
+
+/// The inverse of a 3 × 3 matrix in f64 (the gyroscopic turn's `turned`, [`inertia_of`]).
+pub(crate) struct Inverse64 {
+    rows: [[f64; 3]; 3],
+    /// The determinant of the matrix inverted.
+    pub(crate) det: f64,
+}
+
+impl Inverse64 {
+    /// The inverse of `m` (rows of the adjugate over the determinant), `None` when `m` is
+    /// singular or not finite.
+    pub(crate) fn of(m: Mat3) -> Option<Self> {
+        let c = m.to_cols_array().map(f64::from);
+        // Column-major: a[row][col] = c[col * 3 + row].
+        let a = |r: usize, k: usize| c[k * 3 + r];
+        let cof = |r: usize, k: usize| {
+            let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
+            let (k1, k2) = ((k + 1) % 3, (k + 2) % 3);
+            a(r1, k1) * a(r2, k2) - a(r1, k2) * a(r2, k1)
+        };
+        let det = a(0, 0) * cof(0, 0) + a(0, 1) * cof(0, 1) + a(0, 2) * cof(0, 2);
+        if !(det.is_finite() && det != 0.0) {
+            return None;
+        }
+        // inverse[row][col] = cofactor(col, row) / det.
+        let inv_det = 1.0 / det;
+        Some(Self {
+            rows: std::array::from_fn(|r| std::array::from_fn(|k| cof(k, r) * inv_det)),
+            det,
+        })
+    }
+
+    /// The inverse times `v`, rounded to f32 once.
+    pub(crate) fn times(&self, v: Vec3) -> Vec3 {
+        let v = [f64::from(v.x), f64::from(v.y), f64::from(v.z)];
+        let row = |r: usize| {
+            let m = &self.rows[r];
+            (m[0] * v[0] + m[1] * v[1] + m[2] * v[2]) as f32
+        };
+        Vec3::new(row(0), row(1), row(2))
+    }
 }
 
 /// The largest s ∈ [0, 1] for which a body of `mass` (kg) and world `inertia` at the velocities

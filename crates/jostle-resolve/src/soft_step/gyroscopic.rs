@@ -13,6 +13,7 @@
 //! substep and kept energy to 0.02% at 10 rad/s, but at 1000 rad/s (2 rad per substep) a
 //! free box lost 75% of |L| in 2 s (benches/RESULTS.md, "Spin at any rate").
 
+use crate::energy::Inverse64;
 use jostle_math::{Mat3, Quat, Vec3, advance_orientation, integrate_orientation};
 
 /// The inertia tensor I = (world inverse inertia)⁻¹ when the inverse is invertible, else
@@ -150,43 +151,6 @@ pub fn turn_against(
 fn turned(q: Quat, v: Vec3, m: impl Fn(Vec3) -> Vec3) -> Vec3 {
     let n = q.length_squared();
     q * m(q.conjugate() * v) * (1.0 / (n * n))
-}
-
-/// The inverse of a 3 × 3 matrix in f64 ([`turned`]).
-struct Inverse64([[f64; 3]; 3]);
-
-impl Inverse64 {
-    /// The inverse of `m` (rows of the adjugate over the determinant), `None` when `m` is
-    /// singular or not finite.
-    fn of(m: Mat3) -> Option<Self> {
-        let c = m.to_cols_array().map(f64::from);
-        // Column-major: a[row][col] = c[col * 3 + row].
-        let a = |r: usize, k: usize| c[k * 3 + r];
-        let cof = |r: usize, k: usize| {
-            let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
-            let (k1, k2) = ((k + 1) % 3, (k + 2) % 3);
-            a(r1, k1) * a(r2, k2) - a(r1, k2) * a(r2, k1)
-        };
-        let det = a(0, 0) * cof(0, 0) + a(0, 1) * cof(0, 1) + a(0, 2) * cof(0, 2);
-        if !(det.is_finite() && det != 0.0) {
-            return None;
-        }
-        // inverse[row][col] = cofactor(col, row) / det.
-        let inv_det = 1.0 / det;
-        Some(Self(std::array::from_fn(|r| {
-            std::array::from_fn(|k| cof(k, r) * inv_det)
-        })))
-    }
-
-    /// The inverse times `v`, rounded to f32 once.
-    fn times(&self, v: Vec3) -> Vec3 {
-        let v = [f64::from(v.x), f64::from(v.y), f64::from(v.z)];
-        let row = |r: usize| {
-            let m = &self.0[r];
-            (m[0] * v[0] + m[1] * v[1] + m[2] * v[2]) as f32
-        };
-        Vec3::new(row(0), row(1), row(2))
-    }
 }
 
 /// Whether the world inertia `inertia` turned by `q` is off the contact rows' inverse

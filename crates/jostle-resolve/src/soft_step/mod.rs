@@ -659,17 +659,23 @@ trait Staged: Sync {
 /// Runs `work` on `team` with `threads` threads: first on a [`Plan`], which learns its
 /// stages into `plan`, then on the team reset for them.
 fn run_on_team(team: &mut Team, plan: &mut Vec<team::Parts>, threads: usize, work: &impl Staged) {
-    // The plan's stages go into `plan`'s own storage: no allocation once it has grown.
+    learn_plan(plan, threads, |planned| work.run(planned));
+    team.reset(threads, plan);
+    team::run(team, |member| work.run(member));
+}
+
+/// Runs `run` on a [`Plan`] for `threads` threads whose stages it learns into `plan` (its own
+/// storage, reused: no allocation once it has grown; a new `Vec` each step made 9 allocations
+/// a step on the 20-row pyramid).
+fn learn_plan(plan: &mut Vec<team::Parts>, threads: usize, run: impl FnOnce(&Plan)) {
     let mut stages = std::mem::take(plan);
     stages.clear();
     let planned = Plan {
         threads,
         stages: std::cell::RefCell::new(stages),
     };
-    work.run(&planned);
+    run(&planned);
     *plan = planned.stages.into_inner();
-    team.reset(threads, plan);
-    team::run(team, |member| work.run(member));
 }
 
 /// Batches per item of the team's stage that writes the step's results ([`Results`]).
@@ -1223,14 +1229,9 @@ impl Resolver for SoftStepResolver {
                 },
             };
             if threads > 1 {
-                let mut stages = std::mem::take(&mut self.plan);
-                stages.clear();
-                let plan = Plan {
-                    threads,
-                    stages: std::cell::RefCell::new(stages),
-                };
-                work.run(&plan, &Timing::default());
-                self.plan = plan.stages.into_inner();
+                learn_plan(&mut self.plan, threads, |plan| {
+                    work.run(plan, &Timing::default());
+                });
                 self.team.reset(threads, &self.plan);
                 // The first thread's times: each stage's wall time, waits included.
                 let times = std::sync::Mutex::new([Duration::ZERO; 3]);
