@@ -240,10 +240,11 @@ fn a_pyramid_with_a_100_times_heavier_top_box_stays_up_at_the_default_settings()
     assert_stands(file, &o);
 }
 
-/// Kinetic energies and flips of the spinning box of `dzhanibekov.ron` over `seconds`:
-/// (initial energy, largest relative energy error, flips). A flip is a sign change of the
-/// box's Y axis (the spin axis at the start) along the constant angular momentum.
-fn spin(seconds: f32, resolver: Option<ResolverChoice>) -> (f64, f64, u32) {
+/// Kinetic energies and flips of the spinning box of `dzhanibekov.ron` over `seconds` in steps
+/// of `dt`: (initial energy, largest relative energy error, largest relative rise, flips). A
+/// flip is a sign change of the box's Y axis (the spin axis at the start) along the constant
+/// angular momentum.
+fn spin(seconds: f32, dt: f32, resolver: Option<ResolverChoice>) -> (f64, f64, f64, u32) {
     let scene = scene("dzhanibekov.ron");
     let mut settings = scene.settings();
     if let Some(r) = resolver {
@@ -255,9 +256,9 @@ fn spin(seconds: f32, resolver: Option<ResolverChoice>) -> (f64, f64, u32) {
     let b = world.body(h).unwrap();
     let momentum_dir = (b.orientation * Vec3::Y).normalize();
     let mut sign = 1.0f32;
-    let (mut flips, mut worst) = (0u32, 0.0f64);
-    for _ in 0..(seconds / scene.dt).round() as u32 {
-        world.step(scene.dt).unwrap();
+    let (mut flips, mut worst, mut rise) = (0u32, 0.0f64, 0.0f64);
+    for _ in 0..(seconds / dt).round() as u32 {
+        world.step(dt).unwrap();
         let b = world.body(h).unwrap();
         let along = (b.orientation * Vec3::Y).dot(momentum_dir);
         // Hysteresis: count a flip only once the axis is well past the other side.
@@ -265,17 +266,34 @@ fn spin(seconds: f32, resolver: Option<ResolverChoice>) -> (f64, f64, u32) {
             sign = -sign;
             flips += 1;
         }
-        worst = worst.max((world.kinetic_energy() - e0).abs() / e0);
+        let error = (world.kinetic_energy() - e0) / e0;
+        worst = worst.max(error.abs());
+        rise = rise.max(error);
     }
-    (e0, worst, flips)
+    (e0, worst, rise, flips)
 }
 
+/// The box flips about every two seconds and keeps its kinetic energy to rounding: the
+/// gyroscopic term keeps the angular momentum exactly and turns the box back onto its energy
+/// (`keep_energy` in the soft step's gyroscopic module). Measured: 1.0·10⁻⁵ over 10 s.
 #[test]
 fn a_box_spun_about_its_intermediate_axis_flips_and_keeps_its_energy() {
-    let (e0, worst, flips) = spin(10.0, None);
+    let (e0, worst, _, flips) = spin(10.0, 1.0 / 60.0, None);
     assert!(e0 > 0.0);
     assert!(flips >= 4, "only {flips} flips in 10 s");
-    assert!(worst < 0.02, "kinetic energy off by {:.3}%", 100.0 * worst);
+    assert!(worst < 1e-4, "kinetic energy off by {worst:e}");
+}
+
+/// At `dt` 1.0 nothing gains energy: the spinning box turns 10 rad a step (1.25 rad a
+/// substep). Before its turns were put back onto its energy it gained 7.6·10⁻⁵ of it in the
+/// first step and lost 13% over 1,000. Measured since: at most 7.8·10⁻⁶ above the start over
+/// 200 steps, the rounding of its f32 state.
+#[test]
+fn a_box_spun_at_one_second_steps_gains_no_energy() {
+    let (_, worst, rise, _) = spin(200.0, 1.0, None);
+    eprintln!("dt 1.0: worst {worst:e}, rise {rise:e}");
+    assert!(rise < 2e-5, "kinetic energy rose by {rise:e}");
+    assert!(worst < 1e-4, "kinetic energy off by {worst:e}");
 }
 
 #[test]
@@ -286,7 +304,7 @@ fn without_the_gyroscopic_term_the_box_does_not_flip() {
         gyroscopic: false,
         ..Default::default()
     };
-    let (_, _, flips) = spin(10.0, Some(ResolverChoice::SoftStep(settings)));
+    let (_, _, _, flips) = spin(10.0, 1.0 / 60.0, Some(ResolverChoice::SoftStep(settings)));
     assert_eq!(flips, 0);
 }
 
