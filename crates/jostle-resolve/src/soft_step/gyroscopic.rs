@@ -133,8 +133,13 @@ pub fn turn_against(
         q = integrate_orientation(q, mid * piece);
         w = omega_at(q)?;
     }
-    // The torque-free turn keeps the kinetic energy ½·ω·L too: put the orientation back on it.
-    (q, w) = keep_energy(q, w, momentum, 0.5 * omega.dot(momentum), &omega_at)?;
+    // The torque-free turn keeps the kinetic energy ½·ω·L too: a free body's orientation is
+    // put back on it. (Not a body with contact rows, whose energy its contacts change by far
+    // more in the same substep: in a rain of tumbling shapes the correction's products made
+    // the turns cost twice as much, 11% → 23% of the step under `perf`.)
+    if !rows {
+        (q, w) = keep_energy(q, w, momentum, 0.5 * omega.dot(momentum), &omega_at)?;
+    }
     if rows && turned_off(inertia, rows_inverse, spread, q) {
         return None;
     }
@@ -174,7 +179,7 @@ fn keep_energy(
 ) -> Option<(Quat, Vec3)> {
     let mut excess = 0.5 * w.dot(momentum) - energy;
     if !(excess.abs() <= MAX_ENERGY_ERROR * energy) {
-        // The turn is too coarse for a correction of its rounding-order error to mean
+        // The turn is too coarse for a correction of its second-order error to mean
         // anything; it stays as it is.
         return Some((q, w));
     }
