@@ -7,10 +7,9 @@
 //!
 //! The stack, the heavy-top pyramid and the mass ratio carry loads of many times a box's weight
 //! on one contact, and a soft contact settles at an overlap of load / (effective mass · ω²).
-//! The stack's and the pyramid's scenes declare stiffer contacts and more substeps than the
-//! defaults (each file says why; chosen against the older 4-substep defaults), and each also
-//! runs here at the defaults, which now hold them too; the mass ratio's scene runs at the
-//! defaults (the soft step solves a heavy body on light ones directly).
+//! Every scene runs at the soft step's defaults (the stack's and the pyramid's once declared
+//! stiffer contacts and more substeps, against the older 4-substep defaults; the mass ratio is
+//! held because the soft step solves a heavy body on light ones directly).
 //!
 //! The 20 s runs of the two big pyramids take longer than the normal suite should (tens of
 //! seconds in the test profile), so the default tests run them for 8 s and the full 20 s
@@ -154,25 +153,14 @@ fn a_385_box_3d_pyramid_stands_still_for_20_s() {
     assert_stands("pyramid3d_10.ron", &o);
 }
 
-/// With the scene's stiffer contacts (6 substeps, 60 Hz, 90 Hz against the ground).
+/// At the resolver's defaults, which the scene names. Once a known failure at the defaults of
+/// the time (4 substeps, 30 Hz, 60 Hz against the ground): the soft contacts settled at an
+/// overlap of load / (effective mass · ω²), the top box sank 59 mm and the stack rocked 17 mm
+/// between 2 s and 20 s, and the scene declared 6 substeps at 60 Hz to stand; it stands at the
+/// defaults since they became 8 substeps with load compensation.
 #[test]
 fn a_stack_of_15_boxes_stands_for_20_s() {
     let o = run_scene("stack_15.ron", 20.0, None);
-    assert_stands("stack_15.ron", &o);
-}
-
-/// At the resolver's defaults (the scene declares its own stiffer contacts). Once a known
-/// failure at the defaults of the time (4 substeps, 30 Hz, 60 Hz against the ground): the soft
-/// contacts settled at an overlap of load / (effective mass · ω²), the top box sank 59 mm and
-/// the stack rocked 17 mm between 2 s and 20 s; it stands since the defaults became 8 substeps
-/// with load compensation.
-#[test]
-fn a_stack_of_15_boxes_stands_for_20_s_at_the_default_settings() {
-    let o = run_scene(
-        "stack_15.ron",
-        20.0,
-        Some(ResolverChoice::SoftStep(Default::default())),
-    );
     assert_stands("stack_15.ron", &o);
 }
 
@@ -217,26 +205,15 @@ fn light_box_under_heavy_box(resolver: Option<ResolverChoice>) {
     }
 }
 
-/// With the scene's stiffer contacts (6 substeps, 60 Hz, 90 Hz against the ground).
+/// At the resolver's defaults, which the scene names. Once a known failure (the heavy top
+/// sank 67 mm at 4 substeps and 30 Hz, and the scene declared 6 substeps at 60 Hz); it stands
+/// since the defaults became 8 substeps with load compensation (the top sinks 5.7 mm). Its
+/// island is too large for the direct solve of heavy-on-light islands, which changes nothing
+/// here.
 #[test]
 fn a_pyramid_with_a_100_times_heavier_top_box_stays_up() {
     let file = "pyramid_heavy_top.ron";
     let o = run_scene(file, 10.0, None);
-    assert_stands(file, &o);
-}
-
-/// At the resolver's defaults (the scene declares its own stiffer contacts). Once a known
-/// failure (the heavy top sank 67 mm at 4 substeps and 30 Hz); it stands since the defaults
-/// became 8 substeps with load compensation (the top sinks 5.7 mm). Its island is too large
-/// for the direct solve of heavy-on-light islands, which changes nothing here.
-#[test]
-fn a_pyramid_with_a_100_times_heavier_top_box_stays_up_at_the_default_settings() {
-    let file = "pyramid_heavy_top.ron";
-    let o = run_scene(
-        file,
-        10.0,
-        Some(ResolverChoice::SoftStep(Default::default())),
-    );
     assert_stands(file, &o);
 }
 

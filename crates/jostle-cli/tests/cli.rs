@@ -101,7 +101,8 @@ fn json_is_one_object_on_stdout() {
 
 #[test]
 fn json_reports_the_contact_rows_solved_directly() {
-    // A stack of 15 boxes is a chain the soft step solves directly; a single box is not.
+    // A light box under a 1,000 times heavier one is an island the soft step solves
+    // directly; a single box is not.
     let direct_rows = |file: &str| {
         let out = jostle()
             .args(["run", "--json", "--steps", "30"])
@@ -113,7 +114,7 @@ fn json_reports_the_contact_rows_solved_directly() {
             serde_json::from_str(String::from_utf8(out.stdout).unwrap().trim()).unwrap();
         v["direct_rows_per_step"].as_f64().unwrap()
     };
-    assert!(direct_rows("stack_15.ron") > 0.0);
+    assert!(direct_rows("mass_ratio_1000.ron") > 0.0);
     assert_eq!(direct_rows("box_drop.ron"), 0.0);
 }
 
