@@ -8,10 +8,13 @@
 //!
 //! The soft step carries L through every substep's turn ([`turn`]): L is taken at
 //! the orientation before the turn and ω recomputed from it at the orientation after. |L| is
-//! kept exactly, whatever the spin rate. The earlier scheme, Catto's linearised implicit step
-//! (GDC 2015, here at its midpoint), solved Euler's equations in a frame frozen for the
-//! substep and kept energy to 0.02% at 10 rad/s, but at 1000 rad/s (2 rad per substep) a
-//! free box lost 75% of |L| in 2 s (benches/RESULTS.md, "Spin at any rate").
+//! kept exactly, whatever the spin rate; a body without contact rows is also turned back onto
+//! the kinetic energy it started the turn with (`keep_energy`), where the turn is fine enough
+//! for that to mean something (below 10 rad a substep in the unit tests). The earlier
+//! scheme, Catto's linearised implicit step (GDC 2015, here at its midpoint), solved Euler's
+//! equations in a frame frozen for the substep and kept energy to 0.02% at 10 rad/s, but at
+//! 1000 rad/s (2 rad per substep) a free box lost 75% of |L| in 2 s (benches/RESULTS.md,
+//! "Spin at any rate").
 
 use crate::energy::Inverse64;
 use jostle_math::{Mat3, Quat, Vec3, advance_orientation, integrate_orientation};
