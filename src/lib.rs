@@ -48,6 +48,7 @@ pub use jostle_collide::{
     RayHit, SensorEvent, ShapeDesc, ShapeHit, SharedShape,
 };
 pub use jostle_math::{Mat3, Quat, Vec3};
+pub use jostle_resolve::millington::{IterationBudget, PickStrategy, Projection};
 pub use jostle_resolve::soft_step::team::set_threads;
 pub use jostle_resolve::{
     MillingtonResolver, MillingtonSettings, Resolver, SoftStepResolver, SoftStepSettings,
