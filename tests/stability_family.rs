@@ -489,6 +489,7 @@ fn family_table() {
         Ok("heavy") => family::heavy_sweep(),
         Ok("heavy_seeds") => family::heavy_seeds(),
         Ok("tall") => family::tall_variations(),
+        Ok("large") => family::large_perturbed(),
         Ok("unseen") => family::unseen(
             env_number("FAMILY_UNSEEN", 40),
             env_number("FAMILY_UNSEEN_SEED", 1) as u64,

@@ -14,7 +14,8 @@
 //! base family, `FAMILY=variations` only the variations, `FAMILY=heavy` the sweep of heavy
 //! boxes on light ones (`family::heavy_sweep`), `FAMILY=heavy_seeds` the same from many more
 //! seeds (`family::heavy_seeds`), `FAMILY=tall` the tall members' variations
-//! (`family::tall_variations`), `FAMILY=unseen` `FAMILY_UNSEEN` members (default 40) drawn at
+//! (`family::tall_variations`), `FAMILY=large` the members with 10 m boxes from perturbed
+//! starts (`family::large_perturbed`), `FAMILY=unseen` `FAMILY_UNSEEN` members (default 40) drawn at
 //! random from the seed `FAMILY_UNSEEN_SEED` (default 1; `family::unseen`); `FAMILY_ONLY` keeps the cases whose
 //! name contains one of its `|`-separated parts, or begins with a part written `^part`, as in
 //! `family_table`). With `--test` (`cargo
@@ -71,6 +72,8 @@ fn main() {
         cases.extend(family::heavy_seeds());
     } else if which == "tall" {
         cases.extend(family::tall_variations());
+    } else if which == "large" {
+        cases.extend(family::large_perturbed());
     } else if which == "unseen" {
         let number = |name: &str, default: usize| {
             std::env::var(name).map_or(default, |s| {
