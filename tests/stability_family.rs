@@ -553,6 +553,23 @@ fn rigid_contacts_hold_a_column_of_20_small_boxes() {
     assert_stands_with(&family::column(20, v), 20.0, rigid());
 }
 
+/// The most contact rows the soft step solved directly in any of the first 30 steps of
+/// `generator` (a generator's RON text) on the ground, sleeping off.
+fn most_direct_rows(generator: &str) -> u32 {
+    let ron = format!(
+        "Scene(sleep: (enabled: false), bodies: [Body(name: \"ground\", \
+         shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true)], generators: [{generator}])"
+    );
+    let scene = jostle::scene::Scene::parse(&ron, "chain").unwrap();
+    let mut world = scene.build_with(scene.settings()).unwrap();
+    let mut most = 0;
+    for _ in 0..30 {
+        world.step(1.0 / 60.0).unwrap();
+        most = most.max(world.profile().resolve_stats.direct_rows);
+    }
+    most
+}
+
 #[test]
 fn tall_chains_of_large_boxes_are_solved_directly_from_a_load_path_of_eight() {
     // A chain whose bodies' centres span 20 m or more (`direct::TALL_CHAIN`) is solved
@@ -560,19 +577,9 @@ fn tall_chains_of_large_boxes_are_solved_directly_from_a_load_path_of_eight() {
     // are, one of 7 is not, nor is a column of 10 unit boxes (9 m of centres) or of 10 boxes
     // of 2 m (18 m).
     let direct_rows = |n: u32, half: f32| {
-        let ron = format!(
-            "Scene(sleep: (enabled: false), bodies: [Body(name: \"ground\", \
-             shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true)], generators: \
-             [Stack(count: {n}, half_extents: ({half}, {half}, {half}), friction: 0.5)])"
-        );
-        let scene = jostle::scene::Scene::parse(&ron, "chain").unwrap();
-        let mut world = scene.build_with(scene.settings()).unwrap();
-        let mut most = 0;
-        for _ in 0..30 {
-            world.step(1.0 / 60.0).unwrap();
-            most = most.max(world.profile().resolve_stats.direct_rows);
-        }
-        most
+        most_direct_rows(&format!(
+            "Stack(count: {n}, half_extents: ({half}, {half}, {half}), friction: 0.5)"
+        ))
     };
     // n manifolds of 4 points, each a normal and two friction rows.
     assert_eq!(direct_rows(10, 5.0), 10 * 4 * 3);
@@ -613,20 +620,7 @@ fn chains_are_solved_directly_from_a_load_path_of_sixteen_within_a_budget() {
     // by side on the ground. Together the chains solved directly hold at most
     // `direct_rows` × `CHAIN_ROWS` = 1,024 contact points: of 25 columns of 16 (64 points
     // each) 16 are, the longest first.
-    let direct_rows = |generator: &str| {
-        let ron = format!(
-            "Scene(sleep: (enabled: false), bodies: [Body(name: \"ground\", \
-             shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true)], generators: [{generator}])"
-        );
-        let scene = jostle::scene::Scene::parse(&ron, "chain").unwrap();
-        let mut world = scene.build_with(scene.settings()).unwrap();
-        let mut most = 0;
-        for _ in 0..30 {
-            world.step(1.0 / 60.0).unwrap();
-            most = most.max(world.profile().resolve_stats.direct_rows);
-        }
-        most
-    };
+    let direct_rows = most_direct_rows;
     let column = |n| format!("Stack(count: {n}, half_extents: (0.5, 0.5, 0.5), friction: 0.5)");
     // A column of 16 boxes: 16 manifolds of 4 points, each a normal and two friction rows.
     assert_eq!(direct_rows(&column(16)), 16 * 4 * 3);

@@ -578,11 +578,11 @@ impl DirectIslands {
     /// between two movable bodies, kept when some manifold joins two movable bodies whose
     /// inverse masses differ by [`Limits::mass_ratio`] or more and they have at most
     /// [`Limits::max_rows`] contact points, or when they form a chain (every body touching at
-    /// most two others: a column) whose load path is at least [`Limits::min_chain`] bodies (half
-    /// that if its bodies' centres span [`TALL_CHAIN`] or more), of at most [`CHAIN_ROWS`]
-    /// times `max_rows` points. Each island's rows are ordered
-    /// manifold by manifold outward from one end (`DirectIslands::order_island`), so that its
-    /// system is banded; `bodies` are the solver bodies `states` were loaded from (their world
+    /// most two others: a column) whose load path is at least [`Limits::min_chain`] bodies
+    /// (half that if its bodies' centres span [`TALL_CHAIN`] or more), of at most
+    /// [`CHAIN_ROWS`] times `max_rows` points. Each island's rows are ordered manifold by
+    /// manifold outward from one end (`DirectIslands::order_island`), so that its system is
+    /// banded; `bodies` are the solver bodies `states` were loaded from (their world
     /// inverse inertia builds the couplings). Deterministic: islands in the batches' order.
     pub fn build(
         &mut self,
@@ -706,7 +706,8 @@ impl DirectIslands {
             }
         }
         // The chains solved directly: those with a load path of at least `min_chain` (half of
-        // it for a chain whose centres span `TALL_CHAIN`), the longest first (then by root), while their points together stay within the budget
+        // it for a chain whose centres span `TALL_CHAIN`), the longest first (then by root),
+        // while their points together stay within the budget
         // of `CHAIN_ROWS` times `max_rows`; the others stay with Gauss-Seidel. A chain costs
         // ten to twenty times what Gauss-Seidel costs it, so the budget bounds what a scene
         // of many columns pays: 4,000 boxes landing as 400 columns of ten, each solved

@@ -1429,8 +1429,8 @@ mod thread_choice_tests {
     fn occasional_slow_team_runs_do_not_hide_a_faster_team() {
         // A fifth of the team's runs, at random, are slowed threefold (its second core taken
         // for a while): the team is still the faster on average (1,400 against 1,500), and it
-        // keeps running. (Slowed at a fixed period, a period that divides the trial's length meets
-        // a slow run at every counted step of every trial.)
+        // keeps running. (Slowed at a fixed period, a period that divides the trial's length
+        // meets a slow run at every counted step of every trial.)
         let mut choice = ThreadChoice::default();
         let (mut on_team, mut seed) = (0, 0x9e37_79b9_u32);
         for step in 0..20 * PROBE_INTERVAL {
