@@ -26,8 +26,8 @@
 //! So for an island of at most [`super::SoftStepSettings::direct_rows`] contact points that
 //! holds a contact between two movable bodies whose masses differ by
 //! [`super::SoftStepSettings::direct_mass_ratio`] or more, and for a chain whose load path is
-//! at least a step's sweeps ([`Limits::min_chain`]), or half of them where its bodies' centres
-//! span [`TALL_CHAIN`] or more, the longest chains first while they hold at most
+//! at least a step's sweeps ([`Limits::min_chain`]), or half of them for a chain whose bodies'
+//! sizes add up to [`TALL_CHAIN`] or more, the longest chains first while they hold at most
 //! [`CHAIN_ROWS`] times as many points together:
 //! 1. [`DirectIslands::stiffen`], once per step: each manifold's springs are sized by the
 //!    mass its load stands for, Λ/(|g|·h) for the per-substep impulse Λ its points start the
@@ -117,14 +117,33 @@ const ACTIVE_SET_ROUNDS: usize = 8;
 /// what a scene of many columns pays.
 pub const CHAIN_ROWS: u32 = 16;
 
-/// Span (m) of a chain's body centres from which it is solved directly from half the load
-/// path ([`Limits::min_chain`] / 2): Gauss-Seidel leaves a perturbed column's joints tilted
-/// by about as much whatever its boxes' size, so its top sways in proportion to its height.
-/// Measured on perturbed columns of ten boxes (seeds 21–28, μ 0.3, 0.6 and 0.9, 20 s) left to
-/// Gauss-Seidel: of 1 and 2 m boxes (9 and 18 m of centres) none sways 1 cm, of 4, 6 and 10 m
-/// (36, 54 and 90 m) 7, 4 and 10 of 24; of 14 boxes of 2 m (26 m) 3 of 24, of 12 boxes of 10 m
-/// 23 of 24 (benches/RESULTS.md, "Tall columns of large boxes solved directly").
-pub const TALL_CHAIN: f32 = 20.0;
+/// Length (m) of a chain, the sum of its bodies' sizes ([`body_size`]), from which it is
+/// solved directly from half the load path ([`Limits::min_chain`] / 2): Gauss-Seidel leaves a
+/// perturbed column's joints tilted by about as much whatever its boxes' size, so its top
+/// sways in proportion to its height. A sum of sizes, not the span of the bodies' centres: a
+/// column's span moves with its sink, and a chain whose span sat at the bound went from one
+/// solve to the other step after step, which kicks it (13 unit boxes with a bound of 12 m: 20
+/// of 24 perturbed starts swayed more than 1 cm, up to 38 mm). Measured on perturbed columns
+/// (seeds 21–28, μ 0.3, 0.6 and 0.9, 20 s) left to Gauss-Seidel, starts that sway more than
+/// 1 cm of 24: 12 boxes of 1 m (12 m) none, 13 of 1 m 3, 15 of 1 m 2, 15 of 1.26 m 6, 13 of
+/// 1.5 m 3, 10 of 2 m (20 m) none, 10 of 4, 6 and 10 m 7, 4 and 10, 12 of 10 m 23
+/// (benches/RESULTS.md, "Tall columns of large boxes solved directly"). Between whole
+/// metres, so that no column of unit boxes sits on it (the world inverse inertia's trace
+/// moves in its last bits as a box turns).
+pub const TALL_CHAIN: f32 = 12.5;
+
+/// A body's size (m) for [`TALL_CHAIN`]: the side of the cube with its mass and the trace of
+/// its inertia, √(18·m⁻¹ / tr I⁻¹) from its inverse mass and world inverse inertia (a
+/// rotation keeps the trace); 0 for a body that cannot turn.
+fn body_size(body: &SolverBody) -> f32 {
+    let i = &body.inv_inertia;
+    let trace = i.x_axis.x + i.y_axis.y + i.z_axis.z;
+    if trace > 0.0 {
+        (18.0 * body.inv_mass / trace).sqrt()
+    } else {
+        0.0
+    }
+}
 
 /// Relative slack of the friction cone in [`Solver::fix_sliding_points`]: a point is sliding
 /// when its sticking friction exceeds μ times its normal impulse by more than this.
@@ -267,11 +286,11 @@ pub struct Limits {
     /// step's sweeps (one joint per sweep) is left to it. At the defaults (8 substeps of one
     /// biased and one relax sweep) 16: Gauss-Seidel holds perturbed columns of up to 14 boxes
     /// of 0.1 and 1 m within 1 cm, where at 16 they sway 1.0–1.6 cm. Taller columns of larger
-    /// boxes sway more under it (their tops in proportion to their height), so a chain whose
-    /// centres span [`TALL_CHAIN`] or more is solved directly from half this load path; piles
-    /// and lattices of columns of unit boxes stay at Gauss-Seidel's cost (benches/RESULTS.md,
-    /// "Chains solved directly within a budget" and "Tall columns of large boxes solved
-    /// directly").
+    /// boxes sway more under it (their tops in proportion to their height), so a chain at
+    /// least [`TALL_CHAIN`] long is solved directly from half this load path; piles and
+    /// lattices of columns of up to 12 unit boxes stay at Gauss-Seidel's cost
+    /// (benches/RESULTS.md, "Chains solved directly within a budget" and "Tall columns of
+    /// large boxes solved directly").
     pub min_chain: u32,
 }
 
@@ -325,8 +344,8 @@ pub struct DirectIslands {
     supported: Vec<bool>,
     chain: Vec<bool>,
     unsupported: Vec<u32>,
-    /// Per root: the least and greatest coordinates of its bodies' centres.
-    span: Vec<(Vec3, Vec3)>,
+    /// Per root: the sum of its bodies' sizes ([`body_size`]).
+    length: Vec<f32>,
     /// The chains that may be solved directly, as (load path less one, root).
     chain_roots: Vec<(u32, u32)>,
     seen: Vec<bool>,
@@ -579,7 +598,7 @@ impl DirectIslands {
     /// inverse masses differ by [`Limits::mass_ratio`] or more and they have at most
     /// [`Limits::max_rows`] contact points, or when they form a chain (every body touching at
     /// most two others: a column) whose load path is at least [`Limits::min_chain`] bodies
-    /// (half that if its bodies' centres span [`TALL_CHAIN`] or more), of at most
+    /// (half that if its bodies' sizes add up to [`TALL_CHAIN`] or more), of at most
     /// [`CHAIN_ROWS`] times `max_rows` points. Each island's rows are ordered manifold by
     /// manifold outward from one end (`DirectIslands::order_island`), so that its system is
     /// banded; `bodies` are the solver bodies `states` were loaded from (their world
@@ -671,8 +690,8 @@ impl DirectIslands {
         self.unsupported.resize(states.len(), 0);
         self.seen.clear();
         self.seen.resize(states.len(), false);
-        self.span.clear();
-        self.span.resize(states.len(), (Vec3::MAX, Vec3::MIN));
+        self.length.clear();
+        self.length.resize(states.len(), 0.0);
         let root_of = |sets: &mut UnionFind, a: u32, b: u32| {
             let body = if movable(a) { a } else { b };
             movable(body).then(|| sets.find(body))
@@ -692,9 +711,7 @@ impl DirectIslands {
                 for body in [m.a[l], m.b[l]] {
                     if movable(body) && !self.seen[body as usize] {
                         self.seen[body as usize] = true;
-                        let centre = bodies[body as usize].position;
-                        let (low, high) = &mut self.span[r];
-                        (*low, *high) = (low.min(centre), high.max(centre));
+                        self.length[r] += body_size(&bodies[body as usize]);
                         if self.degree[body as usize] > 0 && !self.supported[body as usize] {
                             self.unsupported[r] += 1;
                         }
@@ -706,7 +723,7 @@ impl DirectIslands {
             }
         }
         // The chains solved directly: those with a load path of at least `min_chain` (half of
-        // it for a chain whose centres span `TALL_CHAIN`), the longest first (then by root),
+        // it for a chain at least `TALL_CHAIN` long), the longest first (then by root),
         // while their points together stay within the budget
         // of `CHAIN_ROWS` times `max_rows`; the others stay with Gauss-Seidel. A chain costs
         // ten to twenty times what Gauss-Seidel costs it, so the budget bounds what a scene
@@ -723,8 +740,7 @@ impl DirectIslands {
             }
             let heavy = self.mixed[r] && self.row_count[r] <= max_rows;
             let path = self.unsupported[r] + 1;
-            let (low, high) = self.span[r];
-            let tall = path >= (min_chain / 2).max(2) && low.distance(high) >= TALL_CHAIN;
+            let tall = path >= (min_chain / 2).max(2) && self.length[r] >= TALL_CHAIN;
             if self.chain[r] && !heavy && (path >= min_chain.max(2) || tall) {
                 self.chain_roots.push((self.unsupported[r], b));
             }

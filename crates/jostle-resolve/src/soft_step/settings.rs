@@ -166,9 +166,9 @@ pub struct SoftStepSettings {
     /// bodies' masses differ widely ([`super::direct`]); a chain of bodies (each touching at
     /// most two others, a column) whose load path (its bodies resting on nothing immovable,
     /// plus one) is at least the step's sweeps (`substeps` × (1 + `relax_iterations`), 16 at
-    /// the defaults), or half of them for a chain whose bodies' centres span
-    /// [`super::direct::TALL_CHAIN`] (20 m) or more, is solved directly, the longest chains first while together they hold
-    /// at most [`super::direct::CHAIN_ROWS`] times as many points. Default 64 (chains: 1,024
+    /// the defaults), or half of them for a chain whose bodies' sizes add up to
+    /// [`super::direct::TALL_CHAIN`] (12.5 m) or more, is solved directly, the longest chains
+    /// first while together they hold at most [`super::direct::CHAIN_ROWS`] times as many points. Default 64 (chains: 1,024
     /// points, 256 unit boxes); 0 turns the direct solve off; at most
     /// [`SoftStepSettings::MAX_DIRECT_ROWS`]. The cost of a general island grows with the cube
     /// of the count, a chain's linearly with its length.
