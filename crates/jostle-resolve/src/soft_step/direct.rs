@@ -133,8 +133,9 @@ pub const CHAIN_ROWS: u32 = 16;
 pub const TALL_CHAIN: f32 = 12.5;
 
 /// A body's size (m) for [`TALL_CHAIN`]: the side of the cube with its mass and the trace of
-/// its inertia, √(18·m⁻¹ / tr I⁻¹) from its inverse mass and world inverse inertia (a
-/// rotation keeps the trace); 0 for a body that cannot turn.
+/// its inverse inertia, √(18·m⁻¹ / tr I⁻¹) (a cube of side s has I⁻¹ = 6/(m·s²) about every
+/// axis; a rotation keeps the trace of the world inverse inertia); 0 for a body that cannot
+/// turn.
 fn body_size(body: &SolverBody) -> f32 {
     let i = &body.inv_inertia;
     let trace = i.x_axis.x + i.y_axis.y + i.z_axis.z;
