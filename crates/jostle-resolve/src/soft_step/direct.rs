@@ -117,10 +117,11 @@ const ACTIVE_SET_ROUNDS: usize = 8;
 /// what a scene of many columns pays.
 pub const CHAIN_ROWS: u32 = 16;
 
-/// Length (m) of a chain, the sum of its bodies' sizes ([`body_size`]), from which it is
-/// solved directly from half the load path ([`Limits::min_chain`] / 2): Gauss-Seidel leaves a
-/// perturbed column's joints tilted by about as much whatever its boxes' size, so its top
-/// sways in proportion to its height. A sum of sizes, not the span of the bodies' centres: a
+/// Length (m) of a chain, the sum of its bodies' sizes (each the side of the cube with the
+/// body's mass and inverse inertia's trace), from which it is solved directly from half the
+/// load path ([`Limits::min_chain`] / 2): Gauss-Seidel leaves a perturbed column's joints
+/// tilted by about as much whatever its boxes' size, so its top sways in proportion to its
+/// height. A sum of sizes, not the span of the bodies' centres: a
 /// column's span moves with its sink, and a chain whose span sat at the bound went from one
 /// solve to the other step after step, which kicks it (13 unit boxes with a bound of 12 m: 20
 /// of 24 perturbed starts swayed more than 1 cm, up to 38 mm). Measured on perturbed columns
@@ -133,9 +134,9 @@ pub const CHAIN_ROWS: u32 = 16;
 pub const TALL_CHAIN: f32 = 12.5;
 
 /// A body's size (m) for [`TALL_CHAIN`]: the side of the cube with its mass and the trace of
-/// its inverse inertia, √(18·m⁻¹ / tr I⁻¹) (a cube of side s has I⁻¹ = 6/(m·s²) about every
-/// axis; a rotation keeps the trace of the world inverse inertia); 0 for a body that cannot
-/// turn.
+/// its inverse inertia, √(18·m⁻¹ / tr I⁻¹) (a cube of side s has I⁻¹ = 6/(m·s²) about
+/// every axis; a rotation keeps the trace of the world inverse inertia); 0 for a body that
+/// cannot turn.
 fn body_size(body: &SolverBody) -> f32 {
     let i = &body.inv_inertia;
     let trace = i.x_axis.x + i.y_axis.y + i.z_axis.z;
