@@ -121,10 +121,10 @@ pub const CHAIN_ROWS: u32 = 16;
 /// body's mass and inverse inertia's trace), from which it is solved directly from half the
 /// load path ([`Limits::min_chain`] / 2): Gauss-Seidel leaves a perturbed column's joints
 /// tilted by about as much whatever its boxes' size, so its top sways in proportion to its
-/// height. A sum of sizes, not the span of the bodies' centres: a
-/// column's span moves with its sink, and a chain whose span sat at the bound went from one
-/// solve to the other step after step, which kicks it (13 unit boxes with a bound of 12 m: 20
-/// of 24 perturbed starts swayed more than 1 cm, up to 38 mm). Measured on perturbed columns
+/// height. A sum of sizes, not the span of the bodies' centres: a column's span moves with its
+/// sink, and a chain whose span sat at the bound went between the two solves, which kicks it
+/// (13 unit boxes with a bound of 12 m: 20 of 24 perturbed starts swayed more than 1 cm, up to
+/// 38 mm, where solved directly throughout none does). Measured on perturbed columns
 /// (seeds 21–28, μ 0.3, 0.6 and 0.9, 20 s) left to Gauss-Seidel, starts that sway more than
 /// 1 cm of 24: 12 boxes of 1 m (12 m) none, 13 of 1 m 3, 15 of 1 m 2, 15 of 1.26 m 6, 13 of
 /// 1.5 m 3, 10 of 2 m (20 m) none, 10 of 4, 6 and 10 m 7, 4 and 10, 12 of 10 m 23
