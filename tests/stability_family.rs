@@ -490,10 +490,7 @@ fn family_table() {
         Ok("heavy_seeds") => family::heavy_seeds(),
         Ok("tall") => family::tall_variations(),
         Ok("large") => family::large_perturbed(),
-        Ok("unseen") => family::unseen(
-            env_number("FAMILY_UNSEEN", 40),
-            env_number("FAMILY_UNSEEN_SEED", 1) as u64,
-        ),
+        Ok("unseen") => family::unseen_from_env(),
         _ => family::base()
             .into_iter()
             .chain(family::variations())
@@ -504,14 +501,6 @@ fn family_table() {
         assert!(o.drift.is_finite() && o.sink_per_layer.is_finite());
         println!("| {} | {} |", case.name, o.cells());
     }
-}
-
-/// The environment variable `name` as a count, `default` when unset.
-fn env_number(name: &str, default: usize) -> usize {
-    std::env::var(name).map_or(default, |s| {
-        s.parse()
-            .unwrap_or_else(|e| panic!("{name}: a count, not {s:?}: {e}"))
-    })
 }
 
 /// The soft step with rigid contacts ([`SoftStepSettings::rigid_contacts`]).

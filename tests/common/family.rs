@@ -525,6 +525,21 @@ pub fn unseen(count: usize, seed: u64) -> Vec<Case> {
         .collect()
 }
 
+/// [`unseen`] with the count and seed from the environment: `FAMILY_UNSEEN` members (default
+/// 40) from `FAMILY_UNSEEN_SEED` (default 1).
+pub fn unseen_from_env() -> Vec<Case> {
+    let number = |name: &str, default: u64| {
+        std::env::var(name).map_or(default, |s| {
+            s.parse()
+                .unwrap_or_else(|e| panic!("{name}: a count, not {s:?}: {e}"))
+        })
+    };
+    unseen(
+        number("FAMILY_UNSEEN", 40) as usize,
+        number("FAMILY_UNSEEN_SEED", 1),
+    )
+}
+
 /// The family's members with 10 m boxes from perturbed starts, which the other sets have from
 /// exact starts only: columns of 10 and 20, planar pyramids of 20 and 40 rows, the 20 × 10
 /// wall and the 3D pyramid of 10, at μ 0.3 and 0.9, from seeds 31 and 32 (24 cases).

@@ -75,16 +75,7 @@ fn main() {
     } else if which == "large" {
         cases.extend(family::large_perturbed());
     } else if which == "unseen" {
-        let number = |name: &str, default: usize| {
-            std::env::var(name).map_or(default, |s| {
-                s.parse()
-                    .unwrap_or_else(|e| panic!("{name}: a count, not {s:?}: {e}"))
-            })
-        };
-        cases.extend(family::unseen(
-            number("FAMILY_UNSEEN", 40),
-            number("FAMILY_UNSEEN_SEED", 1) as u64,
-        ));
+        cases.extend(family::unseen_from_env());
     } else {
         if which != "variations" {
             cases.extend(family::base());
