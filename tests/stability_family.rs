@@ -203,11 +203,13 @@ fn perturbed_heavy_boxes_on_light_ones_stand() {
 
 #[test]
 fn a_perturbed_heavy_topped_column_of_10_m_boxes_rocks_as_one_rigid_body() {
-    // The heavy set's one case that misses the criterion (`1:100 column 5 10m μ0.3 seed7`,
-    // 46.6 mm from 2 s; rapier3d 0.36: 51.8 mm) neither slides nor sways at its joints: its
-    // perturbed drop sets the whole column rocking on the edges of its base, which is what a
-    // rigid column does (benches/RESULTS.md, "Heavy-topped columns of 10 m boxes rock on their
-    // base"). Checked against rigid-body mechanics: the boxes tilt as one body, the base lifts
+    // Four of the heavy seeds' cases miss the criterion (`1:100 column 5 10m μ0.3` from seeds
+    // 9, 12, 14 and 16: 10.1–47.3 mm from 2 s; rapier3d 0.36 misses all twelve 1:100 10 m
+    // columns there). Seed 9's neither slides nor sways at its joints: its perturbed drop sets
+    // the whole column rocking on the edges of its base, which is what a rigid column does
+    // (benches/RESULTS.md, "Heavy-topped columns of 10 m boxes rock on their base"; seed 7,
+    // traced there first, stands since its landing's impact is solved to convergence, "A flat
+    // landing lands flat"). Checked against rigid-body mechanics: the boxes tilt as one body, the base lifts
     // off an edge, the angular deceleration while it does is the gravity torque M·g·b over the
     // inertia about that edge, and each impact on the other edge leaves at most the share of
     // the rocking amplitude a perfectly inelastic rigid impact leaves (Housner's r², r = 1 −
@@ -219,7 +221,7 @@ fn a_perturbed_heavy_topped_column_of_10_m_boxes_rocks_as_one_rigid_body() {
         Variant {
             half: 5.0,
             friction: 0.3,
-            seed: Some(7),
+            seed: Some(9),
         },
     );
     let scene = family::parse(&case);
@@ -255,8 +257,8 @@ fn a_perturbed_heavy_topped_column_of_10_m_boxes_rocks_as_one_rigid_body() {
     let theta: Vec<f32> = tilts.iter().map(|t| t[0].dot(d)).collect();
 
     let largest = theta[120..].iter().fold(0.0f32, |m, t| m.max(t.abs()));
-    // One body: after 2 s the boxes' tilts differ from the base's by a median 0.04% of the
-    // largest tilt (at most 11%, for a step or two as an edge lands).
+    // One body: after 2 s the boxes' tilts differ from the base's by a median 0.05% of the
+    // largest tilt (at most 9%, for a step or two as an edge lands).
     let mut apart: Vec<f32> = tilts[120..]
         .iter()
         .map(|t| {

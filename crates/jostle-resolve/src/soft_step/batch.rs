@@ -164,6 +164,9 @@ pub struct ManifoldLanes<F = F8> {
     pub exact_a: u8,
     /// The same for body B.
     pub exact_b: u8,
+    /// Lanes (bit l for lane l) whose manifold a direct island solves this step
+    /// ([`super::direct::DirectIslands::mark`]); set after packing.
+    pub direct: u8,
     /// The Cholesky factor L of the batch's block system K + ε·diag(K) over its points
     /// ([`super::solve::factor_blocks`], for the block relax): L's entries below the
     /// diagonal row by row (l₁₀, l₂₀, l₂₁, l₃₀, l₃₁, l₃₂), then 1/lᵢᵢ for i = 0..4.
@@ -358,8 +361,9 @@ impl Batches {
         self.contacts = kept as u32;
         if same {
             for m in &mut self.manifolds {
-                // Set again by the resolver where it applies (`mark_exact_warm`).
-                (m.exact_a, m.exact_b) = (0, 0);
+                // Set again by the resolver where it applies (`mark_exact_warm`,
+                // `DirectIslands::mark`).
+                (m.exact_a, m.exact_b, m.direct) = (0, 0, 0);
             }
         } else {
             self.lay_out(bodies.len());
@@ -589,6 +593,7 @@ impl Batches {
             side,
             exact_a: 0,
             exact_b: 0,
+            direct: 0,
             block: [F8::ZERO; BLOCK_ENTRIES],
         });
     }

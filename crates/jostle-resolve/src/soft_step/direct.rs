@@ -595,6 +595,16 @@ impl DirectIslands {
         self.rows.len()
     }
 
+    /// Marks the lanes of `batches` whose manifolds these islands solve
+    /// ([`ManifoldLanes::direct`], clear before).
+    pub fn mark(&self, batches: &mut Batches) {
+        for r in &self.rows {
+            if let Some(m) = batches.manifolds.get_mut(r.batch as usize) {
+                m.direct |= 1 << r.lane;
+            }
+        }
+    }
+
     /// Finds this step's direct islands in the packed `batches`: bodies joined by manifolds
     /// between two movable bodies, kept when some manifold joins two movable bodies whose
     /// inverse masses differ by [`Limits::mass_ratio`] or more and they have at most

@@ -1168,6 +1168,7 @@ impl Resolver for SoftStepResolver {
                 min_chain: sweeps,
             },
         );
+        self.direct.mark(&mut self.batches);
         self.direct
             .stiffen(&mut self.batches, ctx.gravity.length() * h);
         stats.direct_rows = u32::try_from(self.direct.rows()).unwrap_or(u32::MAX);
@@ -1175,11 +1176,10 @@ impl Resolver for SoftStepResolver {
 
         let push_out = self.settings.max_push_out;
         let rigid = self.settings.rigid_contacts;
-        let sweeps = if rigid {
-            self.settings.normal_sweeps.max(1)
-        } else {
-            1
-        };
+        // The relax pass sweeps a manifold's normal rows several times with rigid contacts
+        // only; the biased pass also sweeps them at an impact (`solve::BiasedPass::sweeps`).
+        let normal_sweeps = self.settings.normal_sweeps.max(1);
+        let sweeps = if rigid { normal_sweeps } else { 1 };
         let pass = solve::BiasedPass {
             inv_h,
             max_push_out: push_out,
@@ -1190,11 +1190,12 @@ impl Resolver for SoftStepResolver {
             },
             resting_speed: self.settings.restitution_threshold,
             gravity_speed: ctx.gravity.length() * h,
+            impact_speed: ctx.gravity.length() * ctx.dt,
             friction: self.settings.friction_in_bias_pass
                 || self.settings.relax_iterations == 0
                 || rigid,
             rigid,
-            sweeps,
+            sweeps: normal_sweeps,
             rate: self.settings.push_out_rate * inv_h,
             stored_separation: false,
         };
@@ -1523,6 +1524,11 @@ mod carried_warm_start_tests {
                 exact_warm_ratio: exact,
                 ..SoftStepResolver::default()
             };
+            // One sweep at impacts too: with several, a point's clamp at zero can fall one way
+            // in one run and the other way in the other on a rounding difference, and the
+            // runs then differ by that point's impulse (1.5·10⁻⁴ m/s at 2 and 8 sweeps, not
+            // at 4 or 16), which says nothing about the warm start.
+            resolver.settings.normal_sweeps = 1;
             let mut bodies = scene.bodies.clone();
             let mut contacts = scene.contacts.clone();
             resolver.step(&mut bodies, &mut contacts, &ctx);
