@@ -759,7 +759,14 @@ pub(crate) fn scatter(
             && solver.orientation.is_finite()
             && solver.linear_velocity.is_finite()
             && solver.angular_velocity.is_finite();
-        if !finite {
+        // Beyond the limits a scene's body is held to, the state is no longer one the engine
+        // holds (f32 resolves 6 cm at 10⁶ m), and a snapshot of it would be refused on loading
+        // (a ball thrown at 99,999 m/s with `--dt 1` was 1.1·10⁶ m out after 11 steps and went
+        // on to 10⁸ m; its snapshot could not be read back).
+        let in_range = solver.position.abs().max_element() <= crate::MAX_POSITION
+            && solver.linear_velocity.length() <= crate::MAX_SPEED
+            && solver.angular_velocity.length() <= crate::MAX_REACHED_ANGULAR_SPEED;
+        if !(finite && in_range) {
             body.freeze();
             report.quarantined.push((handle, body.name.clone()));
             continue;

@@ -201,6 +201,17 @@ fn a_snapshot_with_invalid_settings_is_refused_by_name() {
             "gravity: Vec3(NaN, -9.81, 0.0)",
             "settings.gravity",
         ),
+        // A threshold of −1 put every body to sleep at its first step.
+        (
+            "threshold: 0.3",
+            "threshold: -1.0",
+            "settings.sleep.threshold",
+        ),
+        (
+            "bias_base: 0.5",
+            "bias_base: 5.0",
+            "settings.sleep.bias_base",
+        ),
     ];
     for (from, to, field) in edits {
         assert!(

@@ -276,3 +276,40 @@ fn api_values_beyond_the_limits_are_refused() {
     assert!(matches!(world.step(11.0), Err(StepError::InvalidDt(_))));
     assert!(world.step(10.0).is_ok());
 }
+
+#[test]
+fn a_body_that_leaves_the_limits_is_frozen_and_its_snapshot_reads_back() {
+    // A ball thrown at 99,999 m/s with steps of 1 s: 1.1·10⁶ m out after 11 steps, beyond the
+    // 10⁶ m a scene's body is held to. It went on to 10⁸ m unreported, and the snapshot
+    // written of it was refused on loading ("position: 1.100e6 m is above the limit").
+    use jostle::{BodyDesc, ShapeDesc, Vec3, WorldSettings};
+    let mut world = World::new(WorldSettings {
+        gravity: Vec3::ZERO,
+        ..WorldSettings::default()
+    });
+    let h = world
+        .add_body(
+            BodyDesc::dynamic("ball", ShapeDesc::Ball { radius: 0.5 })
+                .moving(Vec3::new(99_999.0, 0.0, 0.0), Vec3::ZERO),
+        )
+        .expect("adds");
+    let mut frozen_at = None;
+    for step in 1..=20 {
+        let report = world.step(1.0).expect("steps");
+        if report.quarantined.iter().any(|(q, _)| *q == h) {
+            frozen_at = Some(step);
+            break;
+        }
+    }
+    // Frozen at the step that would have taken it past 10⁶ m, where it last was within.
+    assert_eq!(frozen_at, Some(11));
+    let ball = world.body(h).expect("ball");
+    assert!(
+        ball.position.x <= 1.0e6 && ball.position.x > 9.9e5,
+        "{}",
+        ball.position
+    );
+    let text = world.snapshot("far", 1.0).to_ron().expect("writes");
+    let back = World::from_snapshot(Snapshot::parse(&text, "far").expect("parses"));
+    assert!(back.is_ok(), "{:?}", back.err());
+}

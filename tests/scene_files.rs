@@ -278,6 +278,28 @@ fn generators_that_would_exhaust_memory_are_errors() {
     // A 100,000-row pyramid is 5·10⁹ boxes; 1,000 rows (500,500) is fine.
     assert!(Scene::parse("Scene(generators: [Pyramid(rows: 100000)])", "p.ron").is_err());
     assert!(Scene::parse("Scene(generators: [Pyramid(rows: 1000)])", "p.ron").is_ok());
+    // Within the bound one by one, beyond it together: two of 500,500 boxes.
+    let e = error(
+        "Scene(generators: [Pyramid(rows: 1000, name: \"a\"), Pyramid(rows: 1000, name: \"b\")])",
+    );
+    let text = e.to_string();
+    assert!(
+        text.contains("generators") && text.contains("1001000 bodies"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_generator_density_beyond_the_limit_names_the_generator() {
+    // It was reported as the first generated body's field (`body "stack-0": field density`).
+    let e = error("Scene(generators: [Stack(count: 3, density: 1e13)])");
+    let text = e.to_string();
+    assert!(
+        text.contains("generators[0].density") && text.contains("above the limit"),
+        "{e}"
+    );
+    let e = error("Scene(generators: [Pyramid(rows: 3, top_density: 1e13)])");
+    assert!(e.to_string().contains("generators[0].top_density"), "{e}");
 }
 
 #[test]

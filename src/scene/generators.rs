@@ -163,9 +163,10 @@ fn cuboid(name: String, h: Vec3, centre: Vec3, friction: f32, density: f32) -> B
 }
 
 impl Generator {
-    /// The most bodies one generator may make: beyond it a scene would exhaust memory (the
-    /// generators' counts multiply: `Piles(nx: 100000, nz: 100000, height: 100000)` is 10¹⁵
-    /// boxes) before its first step.
+    /// The most bodies one generator may make, and a scene's generators and bodies together
+    /// ([`super::Scene::validate`]): beyond it a scene would exhaust memory (the generators'
+    /// counts multiply: `Piles(nx: 100000, nz: 100000, height: 100000)` is 10¹⁵ boxes) before
+    /// its first step.
     pub const MAX_BODIES: u64 = 1_000_000;
 
     /// How many bodies [`Generator::bodies`] makes (for `Wall`, at most this many: a running
@@ -218,6 +219,21 @@ impl Generator {
                 ))
             }
         };
+        // A density the bodies would refuse, named as the generator's field (it was reported
+        // as the first generated body's).
+        let density_ok = |field: &str, d: f32| {
+            positive(field, d)?;
+            if d > crate::MAX_DENSITY {
+                return Err((
+                    field.to_string(),
+                    format!(
+                        "{d:e} kg/m³ is above the limit of {:e} kg/m³",
+                        crate::MAX_DENSITY
+                    ),
+                ));
+            }
+            Ok(())
+        };
         let count = |field: &str, n: u32| {
             if (1..=100_000).contains(&n) {
                 Ok(())
@@ -238,7 +254,7 @@ impl Generator {
                     format!("must be finite and >= 0, got {friction}"),
                 ));
             }
-            positive("density", density)
+            density_ok("density", density)
         };
         match self {
             Self::Pyramid {
@@ -257,7 +273,7 @@ impl Generator {
                     return Err(("gap".into(), format!("must be finite and >= 0, got {gap}")));
                 }
                 if let Some(t) = top_density {
-                    positive("top_density", *t)?;
+                    density_ok("top_density", *t)?;
                 }
                 common(origin, *friction, *density)
             }
@@ -284,7 +300,7 @@ impl Generator {
             } => {
                 count("count", *n)?;
                 if let Some(t) = top_density {
-                    positive("top_density", *t)?;
+                    density_ok("top_density", *t)?;
                 }
                 if !(half_extents.is_finite() && half_extents.min_element() > 0.0) {
                     return Err((

@@ -429,18 +429,8 @@ impl Scene {
             ));
         }
         if let Some(s) = &self.sleep {
-            if !(s.threshold.is_finite() && s.threshold > 0.0) {
-                return Err(setting(
-                    "sleep.threshold",
-                    format!("must be finite and > 0, got {}", s.threshold),
-                ));
-            }
-            if !(s.bias_base.is_finite() && s.bias_base > 0.0 && s.bias_base < 1.0) {
-                return Err(setting(
-                    "sleep.bias_base",
-                    format!("must be in (0, 1), got {}", s.bias_base),
-                ));
-            }
+            s.validate()
+                .map_err(|(field, message)| setting(&format!("sleep.{field}"), message))?;
         }
         if let Some(camera) = &self.camera {
             camera
@@ -470,6 +460,23 @@ impl Scene {
             g.validate().map_err(|(field, message)| {
                 setting(&format!("generators[{i}].{field}"), message)
             })?;
+        }
+        // The bound holds for the scene as a whole: 40 generators of a million boxes each
+        // passed one by one and exhausted memory before the first step.
+        let total = self
+            .generators
+            .iter()
+            .fold(self.bodies.len() as u64, |n, g| {
+                n.saturating_add(g.body_count())
+            });
+        if total > Generator::MAX_BODIES {
+            return Err(setting(
+                "generators",
+                format!(
+                    "make {total} bodies with the scene's own, more than the {} a scene may have",
+                    Generator::MAX_BODIES
+                ),
+            ));
         }
         if let Some(p) = &self.perturb {
             p.validate()

@@ -98,6 +98,9 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         ));
     }
 
+    // The output directory first: an `--out` that names a file failed only after every run.
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("--out {}: cannot create: {e}", args.out.display()))?;
     // Every case up front, so the progress bar knows the total and bad files fail early.
     struct Case {
         path: PathBuf,
@@ -182,9 +185,7 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
     }
     bar.finish_and_clear();
 
-    print!("{}", table(&rows));
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| format!("{}: cannot create: {e}", args.out.display()))?;
+    crate::print_out(&table(&rows))?;
     let csv_path = args.out.join("results.csv");
     let staged = Staged::new(&csv_path);
     std::fs::write(staged.path(), csv(&rows))
@@ -193,9 +194,19 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
     let mut written = vec![csv_path];
     let mut names: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
     names.dedup();
+    // Scene names that make the same file name ("a b", "a/b") get numbered files: the second
+    // plot overwrote the first.
+    let mut stems: Vec<String> = Vec::new();
     for name in names {
         let scene_rows: Vec<&Row> = rows.iter().filter(|r| r.scene == name).collect();
-        written.extend(plot_scene(&args.out, name, &scene_rows)?);
+        let mut stem = slug(name);
+        let mut n = 2;
+        while stems.contains(&stem) {
+            stem = format!("{}_{n}", slug(name));
+            n += 1;
+        }
+        written.extend(plot_scene(&args.out, name, &stem, &scene_rows)?);
+        stems.push(stem);
     }
     for p in written {
         eprintln!("wrote {}", p.display());
@@ -327,12 +338,12 @@ fn error_of(m: &Metrics, plotted: Plotted) -> f64 {
 /// Errors and costs are drawn on log axes; exact zeros are drawn at this floor.
 const FLOOR: f64 = 1e-7;
 
-/// Writes `<out>/<slug>.svg` and `.png`: the scene's error against ms per 1/60 s step, one
+/// Writes `<out>/<stem>.svg` and `.png`: the scene's error against ms per 1/60 s step, one
 /// curve per resolver, points in sweep order.
-fn plot_scene(out: &Path, name: &str, rows: &[&Row]) -> Result<Vec<PathBuf>, String> {
+fn plot_scene(out: &Path, name: &str, stem: &str, rows: &[&Row]) -> Result<Vec<PathBuf>, String> {
     register_font();
     let plotted = Plotted::of(rows);
-    let base = out.join(slug(name));
+    let base = out.join(stem);
     let svg = base.with_extension("svg");
     let png = base.with_extension("png");
     let (svg_staged, png_staged) = (Staged::new(&svg), Staged::new(&png));

@@ -30,6 +30,19 @@ enum Command {
     Bench(bench_cmd::BenchArgs),
 }
 
+/// Writes `text` to standard output. A reader that has gone (`jostle run … | head`) is no
+/// error: the rest is not wanted (`println!` panicked on the closed pipe).
+pub(crate) fn print_out(text: &str) -> Result<(), String> {
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(format!("standard output: {e}"))
+        }
+        _ => Ok(()),
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {

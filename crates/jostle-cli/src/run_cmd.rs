@@ -199,19 +199,21 @@ pub fn run(args: RunArgs) -> Result<(), String> {
         eprintln!("{message}");
     }
     for (step, name) in &summary.quarantined {
-        eprintln!("warning: step {step}: body \"{name}\" went non-finite and was frozen");
+        eprintln!(
+            "warning: step {step}: body \"{name}\" went non-finite or out of range (beyond 1e6 m, 1e5 m/s or 1e6 rad/s) and was frozen"
+        );
     }
 
     let bodies = world.body_count();
-    if args.json {
-        println!(
-            "{}",
+    let text = if args.json {
+        format!(
+            "{}\n",
             json_summary(&scene_name, resolver_name, dt, bodies, &summary)
-        );
+        )
     } else {
-        print_table(&scene_name, resolver_name, dt, bodies, &summary);
-    }
-    Ok(())
+        table_text(&scene_name, resolver_name, dt, bodies, &summary)
+    };
+    crate::print_out(&text)
 }
 
 /// Checks the output files before anything is written, so that a bad one loses nothing: none
@@ -260,10 +262,15 @@ fn identity(path: &Path) -> PathBuf {
     }
 }
 
-/// Whether `path` can be written, without truncating it if it exists.
+/// Whether `path` can be written, without truncating it if it exists. An existing target
+/// that is not a regular file (a device, a named pipe) is not opened: a pipe without a reader
+/// would block here; it is written at the end ([`Staged`]).
 fn writable(path: &Path) -> std::io::Result<()> {
     if path.is_dir() {
         return Err(std::io::Error::other("it is a directory"));
+    }
+    if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+        return Ok(());
     }
     if path.exists() {
         std::fs::OpenOptions::new()
@@ -319,7 +326,7 @@ fn json_summary(scene: &str, resolver: &str, dt: f32, bodies: usize, s: &RunSumm
     .to_string()
 }
 
-fn print_table(scene: &str, resolver: &str, dt: f32, bodies: usize, s: &RunSummary) {
+fn table_text(scene: &str, resolver: &str, dt: f32, bodies: usize, s: &RunSummary) -> String {
     let rows: Vec<(String, String)> = vec![
         ("scene".into(), scene.into()),
         ("resolver".into(), resolver.into()),
@@ -377,7 +384,7 @@ fn print_table(scene: &str, resolver: &str, dt: f32, bodies: usize, s: &RunSumma
     ])
     .collect();
     let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
-    for (k, v) in rows {
-        println!("{k:<width$}  {v}");
-    }
+    rows.iter()
+        .map(|(k, v)| format!("{k:<width$}  {v}\n"))
+        .collect()
 }

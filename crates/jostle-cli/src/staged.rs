@@ -2,34 +2,59 @@
 //! target and renamed over the target only once complete. A run that fails part-way (a
 //! non-finite body, a disk that fills, an interrupt) leaves the target as it was and removes
 //! the temporary file; a reader never sees a half-written trace, image or results table.
+//!
+//! A target that is a symbolic link is followed: the file it names is replaced and the link
+//! kept. A target that exists and is not a regular file (a device such as `/dev/null`, a named
+//! pipe, `/dev/stdout`) cannot be replaced: the output is staged in the temporary directory
+//! and copied into it once complete (renamed over, `/dev/null` became a regular file).
 
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// An output being written to [`Staged::path`], renamed to its target by [`Staged::commit`];
+/// An output being written to [`Staged::path`], moved to its target by [`Staged::commit`];
 /// dropped without a commit, the temporary file is removed.
 #[derive(Debug)]
 pub struct Staged {
     temp: PathBuf,
     target: PathBuf,
+    /// The target is not a regular file: copied into, not renamed over.
+    stream: bool,
     committed: bool,
 }
 
 impl Staged {
     /// Stages `target`: the temporary file is `.NAME.jostle-partial.EXT` in the same directory
-    /// (same file system, so the rename is atomic; the extension kept for writers that pick
-    /// the format from it).
+    /// as the file it replaces (same file system, so the rename is atomic; the extension kept
+    /// for writers that pick the format from it), or in the temporary directory for a target
+    /// that is not a regular file.
     pub fn new(target: &Path) -> Self {
-        let stem = target
+        let stream = std::fs::metadata(target).is_ok_and(|m| !m.is_file() && !m.is_dir());
+        let replaced = if stream {
+            target.to_path_buf()
+        } else {
+            followed(target)
+        };
+        let stem = replaced
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let name = match target.extension() {
+        let name = match replaced.extension() {
             Some(ext) => format!(".{stem}.jostle-partial.{}", ext.to_string_lossy()),
             None => format!(".{stem}.jostle-partial"),
         };
+        let temp = if stream {
+            // Unique within the process and among processes.
+            static NEXT: AtomicUsize = AtomicUsize::new(0);
+            let n = NEXT.fetch_add(1, Ordering::Relaxed);
+            std::env::temp_dir().join(format!("{}-{}-{n}", name, std::process::id()))
+        } else {
+            replaced.with_file_name(name)
+        };
         Self {
-            temp: target.with_file_name(name),
-            target: target.to_path_buf(),
+            temp,
+            target: replaced,
+            stream,
             committed: false,
         }
     }
@@ -39,13 +64,42 @@ impl Staged {
         &self.temp
     }
 
-    /// Moves the finished file over the target.
+    /// Moves the finished file over the target, or copies it into a target that is not a
+    /// regular file.
     pub fn commit(mut self) -> Result<(), String> {
-        std::fs::rename(&self.temp, &self.target)
-            .map_err(|e| format!("{}: cannot write: {e}", self.target.display()))?;
+        let failed = |e: std::io::Error| format!("{}: cannot write: {e}", self.target.display());
+        if self.stream {
+            let mut from = std::fs::File::open(&self.temp).map_err(failed)?;
+            let mut into = std::fs::OpenOptions::new()
+                .write(true)
+                .open(&self.target)
+                .map_err(failed)?;
+            std::io::copy(&mut from, &mut into)
+                .and_then(|_| into.flush())
+                .map_err(failed)?;
+            // The temporary copy is removed on drop.
+            return Ok(());
+        }
+        std::fs::rename(&self.temp, &self.target).map_err(failed)?;
         self.committed = true;
         Ok(())
     }
+}
+
+/// The file a chain of symbolic links starting at `path` names (`path` itself when it is no
+/// link), existing or not; at most 40 links are followed, as the kernel does.
+fn followed(path: &Path) -> PathBuf {
+    let mut path = path.to_path_buf();
+    for _ in 0..40 {
+        let Ok(next) = std::fs::read_link(&path) else {
+            break;
+        };
+        path = match path.parent() {
+            Some(dir) if next.is_relative() => dir.join(next),
+            _ => next,
+        };
+    }
+    path
 }
 
 impl Drop for Staged {
@@ -92,6 +146,48 @@ mod tests {
         }
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "keep");
         assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_symbolic_link_is_followed_and_kept() {
+        let d = dir("link");
+        let (file, link) = (d.join("real.csv"), d.join("link.csv"));
+        std::fs::write(&file, "old").unwrap();
+        std::os::unix::fs::symlink("real.csv", &link).unwrap();
+        let staged = Staged::new(&link);
+        std::fs::write(staged.path(), "new").unwrap();
+        staged.commit().unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+        assert_eq!(std::fs::read_to_string(&file).unwrap(), "new");
+        assert_eq!(std::fs::read_dir(&d).unwrap().count(), 2);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_named_pipe_is_written_into_not_replaced() {
+        use std::os::unix::fs::FileTypeExt as _;
+        let d = dir("fifo");
+        let fifo = d.join("out.csv");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if !made.is_ok_and(|s| s.success()) {
+            eprintln!("no mkfifo here; skipped");
+            return;
+        }
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read_to_string(fifo).unwrap())
+        };
+        let staged = Staged::new(&fifo);
+        assert!(!staged.path().starts_with(&d), "staged beside a pipe");
+        std::fs::write(staged.path(), "through the pipe").unwrap();
+        let temp = staged.path().to_path_buf();
+        staged.commit().unwrap();
+        assert_eq!(reader.join().unwrap(), "through the pipe");
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+        assert!(!temp.exists(), "the temporary copy is left behind");
         std::fs::remove_dir_all(&d).unwrap();
     }
 }

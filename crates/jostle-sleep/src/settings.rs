@@ -21,6 +21,26 @@ pub struct SleepSettings {
     pub bias_base: f32,
 }
 
+impl SleepSettings {
+    /// Checks the fields: the error is (field, message). A threshold of −1 put every body to
+    /// sleep at its first step; a NaN one kept all awake.
+    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+        if !(self.threshold.is_finite() && self.threshold > 0.0) {
+            return Err((
+                "threshold",
+                format!("must be finite and > 0, got {}", self.threshold),
+            ));
+        }
+        if !(self.bias_base.is_finite() && self.bias_base > 0.0 && self.bias_base < 1.0) {
+            return Err((
+                "bias_base",
+                format!("must be in (0, 1), got {}", self.bias_base),
+            ));
+        }
+        Ok(())
+    }
+}
+
 impl Default for SleepSettings {
     fn default() -> Self {
         Self {

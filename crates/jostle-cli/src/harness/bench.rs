@@ -24,7 +24,7 @@
 //!   sampled after every frame; its unit is the declaration's (metres for trajectories and
 //!   apex heights, m/s for the velocities after a collision). `None` for scenes without one.
 //!   It is measured over the whole run, not only after the settle time.
-//! - **quarantined**: bodies whose state went non-finite during the run and were frozen
+//! - **quarantined**: bodies whose state went non-finite or out of range during the run and were frozen
 //!   ([`jostle::StepReport::quarantined`]). A run with any reports an infinite drift and no time
 //!   to sleep, since the frozen body neither stayed put nor slept.
 //!
@@ -342,7 +342,7 @@ pub struct Metrics {
     /// The run against the scene's closed form (`None` when the scene declares none); unit
     /// per [`Analytic`] kind.
     pub analytic_error: Option<f64>,
-    /// Bodies quarantined during the run (their state went non-finite and they were frozen,
+    /// Bodies quarantined during the run (their state went non-finite or out of range and they were frozen,
     /// [`jostle::StepReport::quarantined`]). A run with any has an infinite `drift` and no
     /// `time_to_sleep`: a frozen body neither stays put nor sleeps.
     pub quarantined: usize,
@@ -409,7 +409,9 @@ pub fn run_case(
     let mut energy_error = 0.0f64;
     let mut settled = positions(world, &dynamic);
     let mut quarantined = 0usize;
-    let mut frame_times = Vec::with_capacity(frames as usize);
+    // Reserved for at most 65,536 frames, as `run` reserves its steps: `--duration 1e8` made
+    // the reservation alone a 96 GB allocation (the process aborted), and `1e30` overflowed it.
+    let mut frame_times = Vec::with_capacity(frames.min(1 << 16) as usize);
     let (mut max_pen, mut pen_sum, mut pen_steps) = (0.0f32, 0.0f64, 0u64);
     let mut asleep_since: Option<u64> = None;
 
