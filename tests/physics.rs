@@ -358,7 +358,8 @@ fn a_box_landing_flat_neither_slides_nor_spins() {
     // step's biased pass solved the face's points in one sweep: the first corner took the
     // impact and turned the box, and friction made the spin a slide (a unit box at 50 m/s left
     // the ground at 0.83 m/s sideways and 1.7 rad/s, 1.7% and 3% of the impact speed; 1.5% at
-    // 5 m/s; here, before the impact sweeps, 1.2% sideways at 2 m/s). Sizes 0.1–10 m, impact
+    // 5 m/s; here, without the impact sweeps, the 0.1 m box at 2 m/s kept 0.78% sideways and
+    // 1.4% at a corner). Sizes 0.1–10 m, impact
     // speeds 2–200 m/s, μ 0.3 and 0.9, e 0 and 0.5, square to the axes or turned about the
     // vertical, at 60 and 240 Hz. The Millington resolver's bound is looser: its unit box at
     // 2 m/s, μ 0.9, e 0.5, turned by 0.3 rad, chatters on micro-bounces of 0.1 m/s after its

@@ -202,144 +202,25 @@ fn perturbed_heavy_boxes_on_light_ones_stand() {
 }
 
 #[test]
-fn a_perturbed_heavy_topped_column_of_10_m_boxes_rocks_as_one_rigid_body() {
-    // Four of the heavy seeds' cases miss the criterion (`1:100 column 5 10m μ0.3` from seeds
-    // 9, 12, 14 and 16: 10.1–47.3 mm from 2 s; rapier3d 0.36 misses all twelve 1:100 10 m
-    // columns there). Seed 9's neither slides nor sways at its joints: its perturbed drop sets
-    // the whole column rocking on the edges of its base, which is what a rigid column does
-    // (benches/RESULTS.md, "Heavy-topped columns of 10 m boxes rock on their base"; seed 7,
-    // traced there first, stands since its landing's impact is solved to convergence, "A flat
-    // landing lands flat"). Checked against rigid-body mechanics: the boxes tilt as one body, the base lifts
-    // off an edge, the angular deceleration while it does is the gravity torque M·g·b over the
-    // inertia about that edge, and each impact on the other edge leaves at most the share of
-    // the rocking amplitude a perfectly inelastic rigid impact leaves (Housner's r², r = 1 −
-    // 2·M·b²/I_O): the engine takes out at least as much energy as the rigid ideal, so the
-    // rocking lasts no longer than it physically would.
-    let case = family::heavy_on_light(
-        100.0,
-        5,
-        Variant {
-            half: 5.0,
-            friction: 0.3,
-            seed: Some(9),
-        },
-    );
-    let scene = family::parse(&case);
-    let mut world = scene.build_with(scene.settings()).unwrap();
-    let dt = 1.0 / 60.0;
-    let b = 5.0f32; // half the base's width (m)
-    let boxes = |w: &jostle::World| -> Vec<jostle::RigidBody> {
-        w.bodies()
-            .filter(|(_, _, body)| !body.is_fixed())
-            .map(|(_, _, body)| body.clone())
-            .collect()
-    };
-    // Each step: every box's tilt (the horizontal part of its up axis), the base's height
-    // and angular velocity, and the column's centres.
-    let mut tilts: Vec<Vec<jostle::Vec3>> = Vec::new();
-    let mut base: Vec<(f32, jostle::Vec3)> = Vec::new();
-    let mut centres: Vec<Vec<jostle::Vec3>> = Vec::new();
-    for _ in 0..1200 {
-        world.step(dt).unwrap();
-        let now = boxes(&world);
-        tilts.push(
-            now.iter()
-                .map(|body| (body.orientation * jostle::Vec3::Y).with_y(0.0))
-                .collect(),
+fn perturbed_heavy_topped_columns_of_10_m_boxes_that_rocked_stand() {
+    // `1:100 column 5 10m μ0.3` from seeds 7, 8, 10 and 16 missed the criterion by 10–47 mm
+    // (rapier3d 0.36 misses all twelve such columns of the heavy seeds): each landing set the
+    // whole column rocking on the edges of its base, measured as rigid-body rocking to 0.1%
+    // (benches/RESULTS.md, "Heavy-topped columns of 10 m boxes rock on their base"). What
+    // started it was the landing's impact solved in one sweep, unevenly over a face; with the
+    // impact's rows swept to convergence they stand ("A flat landing lands flat"). Seeds 9,
+    // 12, 14 and 17 still rock after 2 s (10.1–22.1 mm; not traced since).
+    for seed in [7, 8, 10, 16] {
+        let case = family::heavy_on_light(
+            100.0,
+            5,
+            Variant {
+                half: 5.0,
+                friction: 0.3,
+                seed: Some(seed),
+            },
         );
-        base.push((now[0].position.y, now[0].angular_velocity));
-        centres.push(now.iter().map(|body| body.position).collect());
-    }
-    let rest_y = base[1199].0;
-    // The rocking axis, from the base's tilt at 2 s: θ = up·d, θ' = ω·(ŷ × d).
-    let d = tilts[120][0].normalize();
-    let axis = jostle::Vec3::Y.cross(d);
-    let theta: Vec<f32> = tilts.iter().map(|t| t[0].dot(d)).collect();
-
-    let largest = theta[120..].iter().fold(0.0f32, |m, t| m.max(t.abs()));
-    // One body: after 2 s the boxes' tilts differ from the base's by a median 0.05% of the
-    // largest tilt (at most 9%, for a step or two as an edge lands).
-    let mut apart: Vec<f32> = tilts[120..]
-        .iter()
-        .map(|t| {
-            let most = t.iter().map(|tilt| (*tilt - t[0]).length());
-            most.fold(0.0, f32::max) / largest
-        })
-        .collect();
-    apart.sort_by(f32::total_cmp);
-    let (median_apart, most_apart) = (apart[apart.len() / 2], apart[apart.len() - 1]);
-    assert!(
-        median_apart < 0.01 && most_apart < 0.2,
-        "the boxes' tilts differ by a median {median_apart} and at most {most_apart} of the largest"
-    );
-    // On an edge: the base's centre rises by b·sin θ, so it lifts off (by more than a
-    // millimetre after 2 s; the contact springs' static compression is under 0.1 mm).
-    let lift = base[120..]
-        .iter()
-        .map(|(y, _)| y - rest_y)
-        .fold(0.0, f32::max);
-    assert!(lift > 1e-3, "the base lifts {lift} m");
-
-    // The mass and the inertia about a base edge, from the bodies (at rest, at the end).
-    let end = boxes(&world);
-    let (mut m_total, mut i_edge) = (0.0f64, 0.0f64);
-    for body in &end {
-        let (m, inertia) = body.mass_properties().unwrap();
-        let h = f64::from(body.position.y - (rest_y - b));
-        m_total += f64::from(m);
-        i_edge += f64::from((inertia * axis).dot(axis)) + f64::from(m) * (h * h + f64::from(b * b));
-    }
-    let gravity = f64::from(world.settings().gravity.length());
-    let expected = m_total * gravity * f64::from(b) / i_edge;
-    // Angular acceleration while lifted (two consecutive steps with the base raised by more
-    // than 0.5 mm, on one edge): −sign(θ)·M·g·b/I_O, the tilt's small change of the lever
-    // arm (under 1%) aside.
-    let mut decel: Vec<f64> = (120..1199)
-        .filter(|&i| {
-            base[i].0 - rest_y > 5e-4
-                && base[i + 1].0 - rest_y > 5e-4
-                && theta[i].signum() == theta[i + 1].signum()
-        })
-        .map(|i| {
-            let w = |k: usize| f64::from(base[k].1.dot(axis));
-            -(w(i + 1) - w(i)) / f64::from(dt) * f64::from(theta[i].signum())
-        })
-        .collect();
-    assert!(decel.len() > 60, "{} lifted steps", decel.len());
-    decel.sort_by(f64::total_cmp);
-    let median = decel[decel.len() / 2];
-    assert!(
-        (median / expected - 1.0).abs() < 0.03,
-        "angular deceleration {median} rad/s², M·g·b/I_O = {expected}"
-    );
-
-    // Each impact leaves at most Housner's share of the amplitude.
-    let r = 1.0 - 2.0 * m_total * f64::from(b * b) / i_edge;
-    let mut extremes: Vec<f32> = Vec::new();
-    for i in 121..1199 {
-        let a = theta[i].abs();
-        if a > 2e-5 && a > theta[i - 1].abs() && a >= theta[i + 1].abs() {
-            extremes.push(theta[i]);
-        }
-    }
-    assert!(extremes.len() >= 4, "{extremes:?}");
-    for pair in extremes.windows(2) {
-        assert!(pair[0].signum() != pair[1].signum(), "{extremes:?}");
-        let ratio = f64::from(pair[1].abs() / pair[0].abs());
-        assert!(
-            ratio <= r * r,
-            "{extremes:?}: ratio {ratio} above r² = {}",
-            r * r
-        );
-    }
-    // And then it stands: over the last 10 s no box moves sideways by a millimetre.
-    for (step, now) in centres.iter().enumerate().skip(600) {
-        for (p, q) in now.iter().zip(&centres[600]) {
-            assert!(
-                (*p - *q).with_y(0.0).length() < 1e-3,
-                "step {step}: {p} from {q}"
-            );
-        }
+        assert_stands(&case, 20.0);
     }
 }
 

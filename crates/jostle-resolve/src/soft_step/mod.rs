@@ -15,7 +15,9 @@
 //!    warm start (apply the accumulated impulses: point by point in the first substep, then
 //!    as each body's sum carried from substep to substep, [`integrate::Carried`], except for
 //!    bodies touching one [`EXACT_WARM_RATIO`] times heavier or lighter); solve every contact
-//!    once with its soft bias,
+//!    once with its soft bias (a manifold's normal rows [`SoftStepSettings::normal_sweeps`]
+//!    times where a point approached faster than gravity can make it within the step: an
+//!    impact),
 //!    the separation recomputed from the bodies' motion since the start of the step, the
 //!    push-out of deep or unloaded overlap going to pseudo velocities; integrate velocities
 //!    (and the pseudo velocities, which are then cleared) into position and rotation deltas,

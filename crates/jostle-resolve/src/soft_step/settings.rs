@@ -222,9 +222,9 @@ impl SoftStepSettings {
     pub const MAX_DIRECT_ROWS: u32 = 256;
 
     /// The most `substeps`, `relax_iterations`, `restitution_iterations` and `normal_sweeps`
-    /// accepted, and of `substeps` times the larger of `1 + relax_iterations` and
-    /// `normal_sweeps`: 1,024 passes over every contact per step, 16 times the defaults'
-    /// 8 × 8.
+    /// accepted, and of `substeps` times a substep's sweeps (`normal_sweeps +
+    /// relax_iterations`; with rigid contacts `(1 + relax_iterations) × normal_sweeps`):
+    /// 1,024 sweeps over a manifold's rows per step, 14 times the defaults' 8 × 9.
     pub const MAX_PASSES: u32 = 1024;
 
     /// Normal velocity correction (m/s) below which a restitution sweep counts as converged.
@@ -259,17 +259,23 @@ impl SoftStepSettings {
                 ));
             }
         }
-        // And together: each substep runs the biased pass and the relax passes, and sweeps a
-        // manifold's normal rows up to `normal_sweeps` times; `substeps: 1024` with
+        // And together: each substep runs the biased pass (up to `normal_sweeps` sweeps of a
+        // manifold's normal rows at an impact) and the relax passes, each of which sweeps them
+        // `normal_sweeps` times with rigid contacts; `substeps: 1024` with
         // `relax_iterations: 1024` took 47 s for one step of a 210-box pyramid.
-        let per_substep = (1 + self.relax_iterations).max(self.normal_sweeps);
+        let per_substep = if self.rigid_contacts {
+            (1 + self.relax_iterations).saturating_mul(self.normal_sweeps)
+        } else {
+            self.normal_sweeps.saturating_add(self.relax_iterations)
+        };
         let passes = u64::from(self.substeps) * u64::from(per_substep);
         if passes > u64::from(Self::MAX_PASSES) {
             return Err((
                 "substeps",
                 format!(
-                    "substeps × the larger of (1 + relax_iterations) and normal_sweeps must be \
-                     <= {}, got {} × {per_substep} = {passes}",
+                    "substeps × the sweeps of a substep (normal_sweeps + relax_iterations; with \
+                     rigid contacts (1 + relax_iterations) × normal_sweeps) must be <= {}, got \
+                     {} × {per_substep} = {passes}",
                     Self::MAX_PASSES,
                     self.substeps
                 ),
@@ -429,6 +435,16 @@ mod tests {
                 SoftStepSettings {
                     substeps: 256,
                     normal_sweeps: 8,
+                    ..d()
+                },
+                "substeps",
+            ),
+            (
+                SoftStepSettings {
+                    substeps: 1,
+                    relax_iterations: 1023,
+                    normal_sweeps: 1024,
+                    rigid_contacts: true,
                     ..d()
                 },
                 "substeps",
