@@ -22,8 +22,8 @@ pub const MAX_ANGULAR_SPEED: f32 = 1.0e4;
 /// ([`crate::StepReport::quarantined`]), and a snapshot may hold up to it. Above
 /// [`MAX_ANGULAR_SPEED`], since contacts spin thin and tiny bodies faster than anyone would
 /// start them (a 1 mm cube hit at 10⁵ m/s: 2.4·10⁵ rad/s; needles hit at 1,000 m/s pass 10⁴);
-/// its kinetic energy stays finite in f32 up to [`MAX_MASS`] for bodies larger than a
-/// millimetre.
+/// at it, the kinetic energy ½·I·ω² stays finite in f32 for a moment of inertia below about
+/// 6·10²⁶ kg·m² (a cube of water about 80 km wide).
 pub const MAX_REACHED_ANGULAR_SPEED: f32 = 1.0e6;
 
 /// The heaviest body (kg), given as `mass` or reached through `density` × volume: 10²⁴ kg (a
@@ -168,6 +168,80 @@ pub enum Kinematic {
         /// Time for one turn (s).
         period: f32,
     },
+}
+
+/// A kinematic path held to the limits a body is held to: every pose within
+/// [`MAX_POSITION`] of the origin on each axis, its speed within [`MAX_SPEED`] and its spin
+/// within [`MAX_ANGULAR_SPEED`] (`Line(offset: (1e30, 0, 0), period: 1.0)` was accepted and
+/// moved its body at 2.8·10³⁰ m/s). Call after [`KinematicPath::check`]; the error is (field,
+/// message).
+pub(crate) fn path_within_limits(path: &KinematicPath) -> Result<(), (&'static str, String)> {
+    let beyond = |field, what: &str, value: f32, limit: f32, unit: &str| {
+        if value <= limit {
+            Ok(())
+        } else {
+            Err((
+                field,
+                format!("{what} {value:.3e} {unit}, above the limit of {limit:e} {unit}"),
+            ))
+        }
+    };
+    match *path {
+        KinematicPath::Line {
+            start,
+            offset,
+            period,
+            ..
+        } => {
+            let far = start.abs().max((start + offset).abs()).max_element();
+            beyond(
+                "offset",
+                "takes the body",
+                far,
+                MAX_POSITION,
+                "m from the origin",
+            )?;
+            // start + offset·(1 − cos(2πt/T))/2: the fastest at π·|offset|/T.
+            let speed = std::f32::consts::PI * offset.length() / period;
+            beyond("period", "moves the body at up to", speed, MAX_SPEED, "m/s")
+        }
+        KinematicPath::Turn {
+            start,
+            center,
+            axis,
+            period,
+            ..
+        } => {
+            let axis = axis.normalize_or_zero();
+            let arm = (start - center) - axis * (start - center).dot(axis);
+            let far = (center + axis * (start - center).dot(axis))
+                .abs()
+                .max_element()
+                + arm.length();
+            beyond(
+                "center",
+                "takes the body",
+                far,
+                MAX_POSITION,
+                "m from the origin",
+            )?;
+            let spin = std::f32::consts::TAU / period.abs();
+            beyond(
+                "period",
+                "turns the body at",
+                spin,
+                MAX_ANGULAR_SPEED,
+                "rad/s",
+            )?;
+            beyond(
+                "period",
+                "moves the body at",
+                spin * arm.length(),
+                MAX_SPEED,
+                "m/s",
+            )
+        }
+    }
 }
 
 impl Kinematic {
@@ -444,6 +518,7 @@ impl BodyDesc {
             let rotation = unit_rotation(self.rotation).unwrap_or(Quat::IDENTITY);
             if let (_, Some(path)) = kinematic.start(self.position, rotation) {
                 path.check()
+                    .and_then(|()| path_within_limits(&path))
                     .map_err(|(field, message)| err(&format!("kinematic.{field}"), message))?;
             }
         }

@@ -252,6 +252,9 @@ mod file {
             crate::MAX_REACHED_ANGULAR_SPEED,
             "rad/s",
         )?;
+        if let Some(path) = body.path() {
+            crate::body_desc::path_within_limits(path).map_err(|(_, message)| ("path", message))?;
+        }
         if !body.is_immovable() {
             check("mass", body.mass(), MAX_MASS, "kg")?;
             let dt = if dt.is_finite() && dt > 0.0 { dt } else { 1.0 };

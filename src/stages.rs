@@ -737,7 +737,9 @@ fn rewound_velocity(v: Vec3, a: Vec3, moved: Vec3, dropped: f32) -> Vec3 {
 
 /// Copies poses and velocities back into the bodies, the contacts' impulses and preloads back
 /// into the narrow phase's contact list (its persistent points take them at its next update),
-/// and quarantines bodies whose new state is not finite.
+/// and quarantines bodies whose new state is not finite or beyond the limits (a position
+/// beyond [`crate::MAX_POSITION`], a speed beyond [`crate::MAX_SPEED`], a spin beyond
+/// [`crate::MAX_REACHED_ANGULAR_SPEED`]).
 pub(crate) fn scatter(
     bodies: &mut BodySet,
     narrow: &mut NarrowPhase,

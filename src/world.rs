@@ -981,6 +981,7 @@ impl World {
         self.settled = false;
         if let Some(path) = &path {
             path.check()
+                .and_then(|()| crate::body_desc::path_within_limits(path))
                 .map_err(|(field, message)| invalid((&format!("path.{field}"), message)))?;
         }
         let body_type = self

@@ -303,6 +303,48 @@ fn a_generator_density_beyond_the_limit_names_the_generator() {
 }
 
 #[test]
+fn kinematic_paths_beyond_the_limits_name_the_field() {
+    // `Line(offset: (1e30, 0, 0))` was accepted and moved its body at 2.8·10³⁰ m/s; a turn
+    // once a millisecond about an axis 10⁵ m away, at 6·10⁸ m/s.
+    let body = |path: &str| {
+        format!("Scene(bodies: [Body(name: \"k\", shape: Ball(radius: 0.5), kinematic: {path})])")
+    };
+    let cases = [
+        (
+            "Line(offset: (1e30, 0.0, 0.0), period: 1.0)",
+            "kinematic.offset",
+        ),
+        (
+            "Line(offset: (100.0, 0.0, 0.0), period: 1e-4)",
+            "kinematic.period",
+        ),
+        (
+            "Turn(center: (1e5, 1.0, 0.0), axis: (0.0, 1.0, 0.0), period: 1e-3)",
+            "kinematic.period",
+        ),
+        (
+            "Turn(center: (0.0, 0.0, 0.0), axis: (0.0, 1.0, 0.0), period: 1e-4)",
+            "kinematic.period",
+        ),
+        (
+            "Turn(center: (2e6, 0.0, 0.0), axis: (0.0, 1.0, 0.0), period: 1e6)",
+            "kinematic.center",
+        ),
+    ];
+    for (path, field) in cases {
+        let e = error(&body(path));
+        assert!(e.to_string().contains(field), "{path}: {e}");
+    }
+    // The paddle's turn and a slow line are fine.
+    for path in [
+        "Turn(center: (0.0, 0.6, 0.0), axis: (0.0, 1.0, 0.0), period: 8.0)",
+        "Line(offset: (4.0, 0.0, 0.0), period: 2.0)",
+    ] {
+        assert!(Scene::parse(&body(path), "k.ron").is_ok(), "{path}");
+    }
+}
+
+#[test]
 fn values_beyond_what_f32_physics_holds_name_the_field_and_the_limit() {
     let message = |text: &str| match error(text) {
         SceneError::Body {

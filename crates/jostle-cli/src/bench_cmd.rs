@@ -185,7 +185,6 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
     }
     bar.finish_and_clear();
 
-    crate::print_out(&table(&rows))?;
     let csv_path = args.out.join("results.csv");
     let staged = Staged::new(&csv_path);
     std::fs::write(staged.path(), csv(&rows))
@@ -208,6 +207,8 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         written.extend(plot_scene(&args.out, name, &stem, &scene_rows)?);
         stems.push(stem);
     }
+    // The table last: an unwritable standard output loses no file.
+    crate::print_out(&table(&rows))?;
     for p in written {
         eprintln!("wrote {}", p.display());
     }

@@ -269,9 +269,13 @@ fn writable(path: &Path) -> std::io::Result<()> {
     if path.is_dir() {
         return Err(std::io::Error::other("it is a directory"));
     }
-    if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+    // The file that will be replaced: a link's target (a dangling link was refused here as
+    // "File exists"), or nothing to check for a target written into.
+    let (path, stream) = crate::staged::resolve(path);
+    if stream {
         return Ok(());
     }
+    let path = path.as_path();
     if path.exists() {
         std::fs::OpenOptions::new()
             .write(true)

@@ -5,8 +5,11 @@
 //!
 //! A target that is a symbolic link is followed: the file it names is replaced and the link
 //! kept. A target that exists and is not a regular file (a device such as `/dev/null`, a named
-//! pipe, `/dev/stdout`) cannot be replaced: the output is staged in the temporary directory
-//! and copied into it once complete (renamed over, `/dev/null` became a regular file).
+//! pipe), or that lies under `/dev` or `/proc` (`/dev/stdout`), cannot be replaced: the output
+//! is staged in the temporary directory and written into it once complete (renamed over,
+//! `/dev/null` became a regular file, and `/dev/stdout` redirected to a file replaced the
+//! file). Such an output is not written whole or not at all: a reader of a pipe sees it as it
+//! is copied.
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -26,30 +29,21 @@ pub struct Staged {
 impl Staged {
     /// Stages `target`: the temporary file is `.NAME.jostle-partial.EXT` in the same directory
     /// as the file it replaces (same file system, so the rename is atomic; the extension kept
-    /// for writers that pick the format from it), or in the temporary directory for a target
-    /// that is not a regular file.
+    /// for writers that pick the format from it), or a new file of the temporary directory,
+    /// with the extension too, for a target that is not a regular file ([`resolve`]).
     pub fn new(target: &Path) -> Self {
-        let stream = std::fs::metadata(target).is_ok_and(|m| !m.is_file() && !m.is_dir());
-        let replaced = if stream {
-            target.to_path_buf()
-        } else {
-            followed(target)
-        };
+        let (replaced, stream) = resolve(target);
         let stem = replaced
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let name = match replaced.extension() {
-            Some(ext) => format!(".{stem}.jostle-partial.{}", ext.to_string_lossy()),
-            None => format!(".{stem}.jostle-partial"),
-        };
+        let ext = replaced
+            .extension()
+            .map_or(String::new(), |e| format!(".{}", e.to_string_lossy()));
         let temp = if stream {
-            // Unique within the process and among processes.
-            static NEXT: AtomicUsize = AtomicUsize::new(0);
-            let n = NEXT.fetch_add(1, Ordering::Relaxed);
-            std::env::temp_dir().join(format!("{}-{}-{n}", name, std::process::id()))
+            temp_file(&stem, &ext)
         } else {
-            replaced.with_file_name(name)
+            replaced.with_file_name(format!(".{stem}.jostle-partial{ext}"))
         };
         Self {
             temp,
@@ -65,13 +59,13 @@ impl Staged {
     }
 
     /// Moves the finished file over the target, or copies it into a target that is not a
-    /// regular file.
+    /// regular file (appending: `/dev/stdout` redirected to a file keeps what it holds).
     pub fn commit(mut self) -> Result<(), String> {
         let failed = |e: std::io::Error| format!("{}: cannot write: {e}", self.target.display());
         if self.stream {
             let mut from = std::fs::File::open(&self.temp).map_err(failed)?;
             let mut into = std::fs::OpenOptions::new()
-                .write(true)
+                .append(true)
                 .open(&self.target)
                 .map_err(failed)?;
             std::io::copy(&mut from, &mut into)
@@ -86,11 +80,22 @@ impl Staged {
     }
 }
 
-/// The file a chain of symbolic links starting at `path` names (`path` itself when it is no
-/// link), existing or not; at most 40 links are followed, as the kernel does.
-fn followed(path: &Path) -> PathBuf {
-    let mut path = path.to_path_buf();
+/// Where an output for `target` goes, and whether it is written into rather than replaced. A
+/// target that exists and is not a regular file (a device, a named pipe), or that is or
+/// leads through a link to a path under `/dev` or `/proc` (`/dev/stdout` is a link to
+/// `/proc/self/fd/1`, which names whatever standard output is, perhaps a file the shell
+/// appends to), is written into as given. Otherwise a chain of symbolic links is followed to
+/// the file it names, existing or not (at most 40 links, as the kernel does), which is
+/// replaced; the links stay.
+pub fn resolve(target: &Path) -> (PathBuf, bool) {
+    if std::fs::metadata(target).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+        return (target.to_path_buf(), true);
+    }
+    let mut path = target.to_path_buf();
     for _ in 0..40 {
+        if path.starts_with("/dev") || path.starts_with("/proc") {
+            return (target.to_path_buf(), true);
+        }
         let Ok(next) = std::fs::read_link(&path) else {
             break;
         };
@@ -99,7 +104,31 @@ fn followed(path: &Path) -> PathBuf {
             _ => next,
         };
     }
-    path
+    (path, false)
+}
+
+/// A new, empty file of the temporary directory named after the output, with its extension
+/// last (`.trace.jostle-partial-PID-N.csv`): created exclusively, so that nothing placed there
+/// beforehand is written through.
+fn temp_file(stem: &str, ext: &str) -> PathBuf {
+    static NEXT: AtomicUsize = AtomicUsize::new(0);
+    let dir = std::env::temp_dir();
+    loop {
+        let n = NEXT.fetch_add(1, Ordering::Relaxed);
+        let path = dir.join(format!(
+            ".{stem}.jostle-partial-{}-{n}{ext}",
+            std::process::id()
+        ));
+        match std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&path)
+        {
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            // Any other failure shows when the output is written there.
+            _ => return path,
+        }
+    }
 }
 
 impl Drop for Staged {
