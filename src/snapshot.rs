@@ -179,13 +179,24 @@ mod file {
             Ok(snapshot)
         }
 
-        /// Whether `text` looks like a snapshot rather than a scene (its first item is
-        /// `Snapshot(`), so one command can take either.
+        /// Whether `text` looks like a snapshot rather than a scene (its first item, after
+        /// comments of either kind and RON's `#![enable(...)]` attributes, is `Snapshot(`), so
+        /// one command can take either (a snapshot opening with a block comment was read as a
+        /// scene: "Expected struct Scene but found Snapshot").
         pub fn is_snapshot_text(text: &str) -> bool {
-            text.lines()
-                .map(str::trim)
-                .find(|l| !l.is_empty() && !l.starts_with("//"))
-                .is_some_and(|l| l.starts_with("Snapshot("))
+            let mut rest = text;
+            loop {
+                rest = rest.trim_start();
+                rest = if let Some(r) = rest.strip_prefix("//") {
+                    r.split_once('\n').map_or("", |(_, r)| r)
+                } else if let Some(r) = rest.strip_prefix("/*") {
+                    r.split_once("*/").map_or("", |(_, r)| r)
+                } else if let Some(r) = rest.strip_prefix("#![") {
+                    r.split_once(']').map_or("", |(_, r)| r)
+                } else {
+                    return rest.starts_with("Snapshot(");
+                };
+            }
         }
     }
 
@@ -220,7 +231,11 @@ mod file {
     /// [`crate::MAX_REACHED_ANGULAR_SPEED`]), its pending force and torque to a change of
     /// speed or spin within them over one step of `dt` (a hand-edited `force: (0, -1e30, 0)` or
     /// `angular_velocity: (0, 1e30, 0)` went non-finite at the first step).
-    fn within_limits(body: &RigidBody, dt: f32) -> Result<(), (&'static str, String)> {
+    fn within_limits(
+        body: &RigidBody,
+        dt: f32,
+        gravity: f32,
+    ) -> Result<(), (&'static str, String)> {
         use crate::{MAX_ANGULAR_SPEED, MAX_MASS, MAX_POSITION, MAX_SPEED};
         let check = |field, magnitude: f32, limit: f32, unit| {
             if magnitude <= limit {
@@ -252,6 +267,14 @@ mod file {
             crate::MAX_REACHED_ANGULAR_SPEED,
             "rad/s",
         )?;
+        // The gravity the body feels, as `World::set_gravity_scale` bounds it (a hand-edited
+        // `gravity_scale: 1e30` went non-finite at the first step).
+        check(
+            "gravity_scale",
+            body.gravity_scale.abs() * gravity,
+            crate::MAX_GRAVITY,
+            "m/s² of gravity",
+        )?;
         if let Some(path) = body.path() {
             crate::body_desc::path_within_limits(path).map_err(|(_, message)| ("path", message))?;
         }
@@ -270,6 +293,9 @@ mod file {
         }
         Ok(())
     }
+
+    /// The most steps a snapshot may have counted: 2⁵³.
+    const MAX_STEPS: u64 = 1 << 53;
 
     impl World {
         /// The complete state of the world, for [`World::from_snapshot`]. `scene` and `dt` are
@@ -323,11 +349,13 @@ mod file {
                 .check()
                 .map_err(|e| invalid(format!("colliders: {e}")))?;
             world.bodies = snapshot.bodies;
+            let gravity = world.settings.gravity.length();
             let slots: Vec<_> = world.bodies.iter().map(|(h, _)| h).collect();
             for handle in slots {
                 if let Some(body) = world.bodies.get_mut(handle)
-                    && let Err((field, message)) =
-                        body.check().and_then(|()| within_limits(body, snapshot.dt))
+                    && let Err((field, message)) = body
+                        .check()
+                        .and_then(|()| within_limits(body, snapshot.dt, gravity))
                 {
                     return Err(invalid(format!(
                         "body {} \"{}\": field `{field}`: {message}",
@@ -417,6 +445,15 @@ mod file {
                 return Err(invalid(format!(
                     "time: must be finite and >= 0, got {}",
                     snapshot.time
+                )));
+            }
+            // A step count no run reaches (2⁵³ steps, 4.8 million years at 60 Hz): beyond it
+            // the counter's steps lose their f64 time, and at u64's end the trace's step
+            // numbers wrapped to 0.
+            if snapshot.steps > MAX_STEPS {
+                return Err(invalid(format!(
+                    "steps: must be at most {MAX_STEPS}, got {}",
+                    snapshot.steps
                 )));
             }
             world.time = snapshot.time;

@@ -1035,7 +1035,7 @@ impl World {
     /// wakes it.
     pub fn set_gravity_scale(&mut self, handle: BodyHandle, scale: f32) -> Result<(), StepError> {
         self.settled = false;
-        if !(scale.is_finite() && (scale * self.settings.gravity.length()) <= MAX_GRAVITY) {
+        if !(scale.is_finite() && (scale.abs() * self.settings.gravity.length()) <= MAX_GRAVITY) {
             return Err(invalid((
                 "gravity_scale",
                 format!("must be finite and give at most {MAX_GRAVITY:e} m/s², got {scale}"),

@@ -212,6 +212,12 @@ fn a_snapshot_with_invalid_settings_is_refused_by_name() {
             "bias_base: 5.0",
             "settings.sleep.bias_base",
         ),
+        // A step count at u64's end wrapped the trace's step numbers to 0.
+        (
+            "\n    steps: 1,",
+            "\n    steps: 18446744073709551614,",
+            "steps: must be at most",
+        ),
     ];
     for (from, to, field) in edits {
         assert!(

@@ -221,6 +221,9 @@ fn a_snapshot_names_the_body_or_collider_and_the_field_it_refuses() {
         ),
         ("bodies:", "inv_mass: ", "1.0", "`body_type`"),
         ("colliders:", "restitution: ", "5.0", "restitution"),
+        // Finite, but a gravity of 10³⁰ m/s² put the body out of f32's range at once.
+        ("mass: 999", "gravity_scale: ", "1e30", "`gravity_scale`"),
+        ("mass: 999", "gravity_scale: ", "-1e30", "`gravity_scale`"),
         ("resolver:", "substeps: ", "4294967", "substeps"),
         ("narrow:", "impulse: ", "NaN", "impulse"),
         ("narrow:", "local_p2: ", "1e30", "local_p"),
@@ -344,4 +347,17 @@ fn a_spin_an_impact_gives_past_the_scene_limit_reads_back_from_a_snapshot() {
     let text = world.snapshot("tiny", 1.0 / 60.0).to_ron().expect("writes");
     let back = World::from_snapshot(Snapshot::parse(&text, "tiny").expect("parses"));
     assert!(back.is_ok(), "{:?}", back.err());
+}
+
+#[test]
+fn a_snapshot_is_told_from_a_scene_past_comments_and_attributes() {
+    // A snapshot opening with a block comment was read as a scene ("Expected struct Scene but
+    // found Snapshot").
+    assert!(Snapshot::is_snapshot_text(
+        "// a note\n/* a block\n   comment */ #![enable(implicit_some)]\n  Snapshot(format: 3)"
+    ));
+    assert!(Snapshot::is_snapshot_text("Snapshot("));
+    assert!(!Snapshot::is_snapshot_text("/* Snapshot( */ Scene()"));
+    assert!(!Snapshot::is_snapshot_text("Scene(name: \"Snapshot(\")"));
+    assert!(!Snapshot::is_snapshot_text("/* never closed Snapshot("));
 }

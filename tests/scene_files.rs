@@ -418,6 +418,13 @@ fn duplicate_body_names_are_refused() {
         "Scene(bodies: [Body(name: \"a\", shape: Ball(radius: 1.0)), Body(name: \"a\", shape: Ball(radius: 1.0), position: (3.0, 0.0, 0.0))])",
     );
     assert_eq!((body.as_str(), field.as_str()), ("a", "name"));
+    // Bodies without a name are known by their place: several may go unnamed (two were
+    // refused as sharing the name "").
+    let scene = Scene::parse(
+        "Scene(bodies: [Body(shape: Ball(radius: 1.0)), Body(shape: Ball(radius: 1.0), position: (3.0, 0.0, 0.0))])",
+        "unnamed.ron",
+    );
+    assert!(scene.is_ok(), "{:?}", scene.err());
 }
 
 #[test]
@@ -451,6 +458,18 @@ fn two_confusing_parse_errors_carry_a_hint() {
     let e = error("Scene(name: \"s\", sleep: Some(SleepSettings(enabled: false)), bodies: [])")
         .to_string();
     assert!(e.contains("`sleep: (enabled: false)`"), "{e}");
+    // The same mistake with another type's name, or `Some` around plain parentheses (ron said
+    // "Unexpected field named `Camera` in `Scene`" and "Expected identifier").
+    for text in [
+        "Scene(camera: Some(Camera(position: (1.0, 2.0, 3.0))))",
+        "Scene(sleep: Some((threshold: 0.5)))",
+    ] {
+        let e = error(text).to_string();
+        assert!(
+            e.contains("without `Some` or the type's name"),
+            "{text}: {e}"
+        );
+    }
 }
 
 #[test]

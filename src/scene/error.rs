@@ -289,12 +289,17 @@ fn hint(text: &str, line: usize, column: usize, message: &str) -> Option<&'stati
     if after_digit && fraction {
         return Some("a whole number is expected here, without a fraction or exponent");
     }
-    if message.contains("Unexpected field named `SleepSettings`")
-        || message.contains("Unexpected field named `Some`")
-    {
+    // An optional struct written as `Some(...)` or with its type's name (`SleepSettings(...)`,
+    // `Camera(...)`): ron reads the name as an unexpected field, or `Some((` as an identifier
+    // missing.
+    let named_type = message
+        .split_once("Unexpected field named `")
+        .is_some_and(|(_, rest)| rest.starts_with(|c: char| c.is_ascii_uppercase()));
+    let line_before = before.rsplit('\n').next().unwrap_or("");
+    if named_type || line_before.contains("Some(") {
         return Some(
             "write the settings' fields in parentheses, without `Some` or the type's name: \
-             `sleep: (enabled: false)`",
+             `sleep: (enabled: false)`, `camera: (position: (0.0, 5.0, 10.0))`",
         );
     }
     None

@@ -566,7 +566,9 @@ impl Scene {
 /// apart, and a repeated one would make each of those ambiguous.
 fn unique_names(names: &[&str]) -> Result<(), SceneError> {
     let mut seen = std::collections::HashMap::with_capacity(names.len());
-    for (i, &name) in names.iter().enumerate() {
+    // Bodies without a name (the default) are known by their place, not by name: several may
+    // go unnamed (two were refused as having the same name "").
+    for (i, &name) in names.iter().enumerate().filter(|(_, n)| !n.is_empty()) {
         if let Some(first) = seen.insert(name, i) {
             return Err(SceneError::Body {
                 file: String::new(),

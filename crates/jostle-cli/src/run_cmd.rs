@@ -91,8 +91,13 @@ pub fn run(args: RunArgs) -> Result<(), String> {
     } = load(&args.scene, &overrides).map_err(|e| e.to_string())?;
     let dt = args.dt.unwrap_or(scene_dt);
     if !(dt.is_finite() && dt > 0.0 && dt <= jostle::MAX_DT) {
+        // Named by where it came from: a snapshot's own `dt` was reported as `--dt`.
+        let source = match args.dt {
+            Some(_) => "--dt".to_string(),
+            None => format!("{}: dt", args.scene.display()),
+        };
         return Err(format!(
-            "--dt must be in (0, {}] s, got {dt}",
+            "{source} must be in (0, {}] s, got {dt}",
             jostle::MAX_DT
         ));
     }
