@@ -1032,9 +1032,9 @@ pub struct BiasedPass {
     /// instead of `solve_batch_split`, with `slop` the overlap left alone.
     pub rigid: bool,
     /// Sweeps over a manifold's normal rows ([`super::SoftStepSettings::normal_sweeps`]):
-    /// in every batch with rigid contacts, and with soft ones in a batch where some point
-    /// approached faster than `impact_speed` at the start of the step, in its lanes that no
-    /// direct island solves (`solve_batch_split`).
+    /// every manifold's with rigid contacts; with soft ones, those of a manifold (a lane of
+    /// its batch) that no direct island solves and where some point approached faster than
+    /// `impact_speed` at the start of the step (`solve_batch_split`).
     pub sweeps: u32,
     /// Approach speed (m/s) at the start of the step beyond which a contact is an impact:
     /// |g|·dt, the most that gravity adds in a step (a resting contact approaches at a
@@ -2019,8 +2019,8 @@ mod tests {
             sweeps: 3,
             ..SOFT
         };
-        // Soft contacts whose approaching batches sweep their normal rows (every batch with a
-        // point approaching at all).
+        // Soft contacts whose approaching manifolds sweep their normal rows (every manifold
+        // with a point approaching at all, but the lanes marked as solved directly).
         const IMPACT: BiasedPass = BiasedPass {
             sweeps: 3,
             impact_speed: 0.0,
