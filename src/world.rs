@@ -79,8 +79,9 @@ fn invalid((field, message): (&str, String)) -> StepError {
 pub struct StepReport {
     /// Bodies whose state went non-finite during this step, or beyond the limits a scene's body
     /// is held to ([`crate::MAX_POSITION`] from the origin on an axis, [`crate::MAX_SPEED`]) or
-    /// a spin beyond [`crate::MAX_REACHED_ANGULAR_SPEED`]: each is frozen where it last had a pose within them (it
-    /// becomes a fixed body) and named here. The rest of the world steps on.
+    /// a spin beyond [`crate::MAX_REACHED_ANGULAR_SPEED`]: each is frozen where it last had a
+    /// pose within them (it becomes a fixed body) and named here. The rest of the world steps
+    /// on.
     pub quarantined: Vec<(BodyHandle, String)>,
 }
 

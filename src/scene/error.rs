@@ -291,12 +291,16 @@ fn hint(text: &str, line: usize, column: usize, message: &str) -> Option<&'stati
     }
     // An optional struct written as `Some(...)` or with its type's name (`SleepSettings(...)`,
     // `Camera(...)`): ron reads the name as an unexpected field, or `Some((` as an identifier
-    // missing.
+    // missing (`Some(2.0)` around a number is fine, and an error after it is another one).
     let named_type = message
         .split_once("Unexpected field named `")
         .is_some_and(|(_, rest)| rest.starts_with(|c: char| c.is_ascii_uppercase()));
-    let line_before = before.rsplit('\n').next().unwrap_or("");
-    if named_type || line_before.contains("Some(") {
+    let line = [
+        before.rsplit('\n').next().unwrap_or(""),
+        here.split('\n').next().unwrap_or(""),
+    ]
+    .concat();
+    if named_type || line.contains("Some((") {
         return Some(
             "write the settings' fields in parentheses, without `Some` or the type's name: \
              `sleep: (enabled: false)`, `camera: (position: (0.0, 5.0, 10.0))`",

@@ -205,7 +205,11 @@ pub fn run(args: RunArgs) -> Result<(), String> {
     }
     for (step, name) in &summary.quarantined {
         eprintln!(
-            "warning: step {step}: body \"{name}\" went non-finite or out of range (beyond 1e6 m, 1e5 m/s or 1e6 rad/s) and was frozen"
+            "warning: step {step}: body \"{name}\" went non-finite or out of range (beyond \
+             {:e} m, {:e} m/s or {:e} rad/s) and was frozen",
+            jostle::MAX_POSITION,
+            jostle::MAX_SPEED,
+            jostle::MAX_REACHED_ANGULAR_SPEED
         );
     }
 

@@ -1232,11 +1232,16 @@ fn solve_batch_split<F: Lane, L: LinearResponse<F>>(
     let consts = BiasedConsts::new(&pass);
     // The lanes of an impact that no direct island solves (lanes hold different manifolds:
     // a resting one beside a landing one keeps its single sweep).
-    let impacts = impacts(points, F::splat(-pass.impact_speed));
-    let swept = if pass.sweeps > 1 && impacts.any() {
+    let none = F::ZERO.cmplt(F::ZERO);
+    let impacts = if pass.sweeps > 1 {
+        impacts(points, F::splat(-pass.impact_speed))
+    } else {
+        none
+    };
+    let swept = if impacts.any() {
         impacts & lane_ones::<F>(m.direct).cmple(F::ZERO)
     } else {
-        F::ZERO.cmplt(F::ZERO)
+        none
     };
     if swept.any() {
         // An impact: the manifold's normal rows swept `sweeps` times in all (these, then the
