@@ -37,8 +37,8 @@ pub mod view;
 pub mod world;
 
 pub use body_desc::{
-    BodyDesc, BodyError, Kinematic, MAX_ANGULAR_SPEED, MAX_DENSITY, MAX_DT, MAX_GRAVITY, MAX_MASS,
-    MAX_POSITION, MAX_REACHED_ANGULAR_SPEED, MAX_SPEED, MassSpec,
+    BodyDesc, BodyError, Kinematic, MAX_ANGULAR_SPEED, MAX_CONTACT_MASS_RATIO, MAX_DENSITY, MAX_DT,
+    MAX_GRAVITY, MAX_MASS, MAX_POSITION, MAX_REACHED_ANGULAR_SPEED, MAX_SPEED, MassSpec,
 };
 pub use collider_desc::ColliderDesc;
 pub use jostle_body::{BodyHandle, BodyType, CcdMode, KinematicPath, RigidBody};

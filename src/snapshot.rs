@@ -6,6 +6,11 @@
 //! Files are RON (`Snapshot(format: 3, ...)`); floats are written in Rust's shortest
 //! round-trip form, so nothing is lost. The broad phase is not stored: its pairs are a pure
 //! function of the poses (sorted, filtered exactly), so it is rebuilt on the first step.
+//!
+//! A body's mass and inertia are stored with the body (`mass`, `inertia_body` and their
+//! inverses), not worked out again from its colliders on load: a body may have been given a
+//! mass of its own. Editing a collider's shape in a snapshot file therefore keeps the body's
+//! mass; edit those fields too.
 
 use jostle_body::BodyHandle;
 use jostle_collide::{Material, Pose, ShapeDesc};

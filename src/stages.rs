@@ -244,6 +244,33 @@ pub(crate) fn gather(
         scratch.bodies.push(sb);
     }
     gather_contacts(bodies, contacts, scratch);
+    report_mass_ratios(contacts, scratch, report);
+}
+
+/// Adds to `report` each pair of dynamic bodies among the solver contacts whose masses differ
+/// by more than [`crate::MAX_CONTACT_MASS_RATIO`], lighter first, once per run of its
+/// contacts (a pair's contacts are listed together).
+fn report_mass_ratios(contacts: &[BodyContact], scratch: &Scratch, report: &mut StepReport) {
+    let inv_mass = |i: u32| scratch.bodies.get(i as usize).map_or(0.0, |b| b.inv_mass);
+    let mut last = None;
+    for (c, &source) in scratch.contacts.iter().zip(&scratch.contact_source) {
+        if last == Some((c.a, c.b)) {
+            continue;
+        }
+        last = Some((c.a, c.b));
+        let (ia, ib) = (inv_mass(c.a), inv_mass(c.b));
+        // (Compared as inverse masses: a body that cannot move has none.)
+        if ia > 0.0
+            && ib > 0.0
+            && ia.max(ib) > crate::MAX_CONTACT_MASS_RATIO * ia.min(ib)
+            && let Some(bc) = contacts.get(source as usize)
+        {
+            // The lighter body has the larger inverse mass.
+            report
+                .beyond_mass_ratio
+                .push(if ia > ib { (bc.a, bc.b) } else { (bc.b, bc.a) });
+        }
+    }
 }
 
 /// The read-only inputs of [`convert_contacts`].

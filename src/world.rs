@@ -83,6 +83,10 @@ pub struct StepReport {
     /// pose within them (it becomes a fixed body) and named here. The rest of the world steps
     /// on.
     pub quarantined: Vec<(BodyHandle, String)>,
+    /// Pairs of dynamic bodies in contact this step whose masses differ by more than
+    /// [`crate::MAX_CONTACT_MASS_RATIO`], lighter first: their contacts cannot hold the light
+    /// body in f32 arithmetic, so it may be pressed deep into its neighbours or squeezed out.
+    pub beyond_mass_ratio: Vec<(BodyHandle, BodyHandle)>,
 }
 
 /// A physics world: add bodies, call [`World::step`].

@@ -203,6 +203,14 @@ pub fn run(args: RunArgs) -> Result<(), String> {
         staged.commit()?;
         eprintln!("{message}");
     }
+    for (step, light, heavy, ratio) in &summary.beyond_mass_ratio {
+        eprintln!(
+            "warning: step {step}: body \"{light}\" touches \"{heavy}\", {ratio:.1e} times as \
+             heavy: beyond the mass ratio of {:e} that contacts resolve, the lighter body may \
+             be pressed into its neighbours or squeezed out",
+            jostle::MAX_CONTACT_MASS_RATIO
+        );
+    }
     for (step, name) in &summary.quarantined {
         eprintln!(
             "warning: step {step}: body \"{name}\" went non-finite or out of range (beyond \
@@ -324,11 +332,13 @@ fn json_summary(scene: &str, resolver: &str, dt: f32, bodies: usize, s: &RunSumm
         "awake_final": s.awake_final,
         "all_asleep_step": s.all_asleep_step,
         "quarantined": s.quarantined.len(),
+        "beyond_mass_ratio": s.beyond_mass_ratio.len(),
         "picks_per_step": {
             "position": s.picks_per_step[0],
             "velocity": s.picks_per_step[1],
         },
         "direct_rows_per_step": s.direct_rows_per_step,
+        "team_steps": s.team_steps,
         "residual": {
             "position_median_m": s.residual_median[0],
             "position_max_m": s.residual_max[0],
@@ -380,6 +390,10 @@ fn table_text(scene: &str, resolver: &str, dt: f32, bodies: usize, s: &RunSummar
         (
             "contact rows solved directly per step".into(),
             format!("{:.1}", s.direct_rows_per_step),
+        ),
+        (
+            "steps resolved on more than one thread".into(),
+            format!("{} of {}", s.team_steps, s.steps),
         ),
         (
             "left unresolved, median / max: position (m)".into(),

@@ -79,6 +79,10 @@ pub struct RunSummary {
     pub all_asleep_step: Option<u64>,
     /// Bodies quarantined for non-finite state, with the step.
     pub quarantined: Vec<(u64, String)>,
+    /// Pairs of touching bodies beyond [`jostle::MAX_CONTACT_MASS_RATIO`]
+    /// ([`jostle::StepReport::beyond_mass_ratio`]), each once: the first step, the lighter
+    /// body's name, the heavier's and their mass ratio.
+    pub beyond_mass_ratio: Vec<(u64, String, String, f32)>,
     /// Resolver passes per step, position then velocity (the step profile's `resolve_stats`): picks
     /// (the Millington resolver) or contact sweeps (the soft step), mean over the run.
     pub picks_per_step: [f64; 2],
@@ -91,6 +95,9 @@ pub struct RunSummary {
     /// Contact rows the soft step solved directly per step (the step profile's
     /// `resolve_stats.direct_rows`), mean over the run.
     pub direct_rows_per_step: f64,
+    /// Steps whose resolve stage ran on more than one thread (the soft step's team; the
+    /// step profile's `resolve_stats.threads` above 1).
+    pub team_steps: u64,
 }
 
 impl RunSummary {
@@ -133,16 +140,27 @@ pub fn run(
     let mut residuals: [Vec<f32>; 2] = [Vec::with_capacity(reserve), Vec::with_capacity(reserve)];
     let mut picks = [0u64; 2];
     let mut direct_rows = 0u64;
+    let mut seen_ratios = std::collections::HashSet::new();
     for step in 1..=steps {
         let report = world.step(dt)?;
         s.quarantined
             .extend(report.quarantined.into_iter().map(|(_, name)| (step, name)));
+        for (light, heavy) in report.beyond_mass_ratio {
+            if seen_ratios.insert((light, heavy)) {
+                let name = |h| world.body_name(h).unwrap_or_default().to_string();
+                let mass = |h| world.body(h).map_or(0.0, |b| b.mass());
+                let ratio = mass(heavy) / mass(light);
+                s.beyond_mass_ratio
+                    .push((step, name(light), name(heavy), ratio));
+            }
+        }
         let p = world.profile();
         s.step_times.push(p.total);
         let r = &p.resolve_stats;
         picks[0] += u64::from(r.position_iterations);
         picks[1] += u64::from(r.velocity_iterations);
         direct_rows += u64::from(r.direct_rows);
+        s.team_steps += u64::from(r.threads > 1);
         residuals[0].push(r.position_residual);
         residuals[1].push(r.velocity_residual);
         for (i, (_, t)) in p.stages().iter().enumerate() {
