@@ -35,14 +35,14 @@ pub const MAX_MASS: f32 = 1.0e24;
 /// resolves 6 cm (the reach of shapes is bounded alike: `jostle_collide::shape::MAX_EXTENT`).
 pub const MAX_POSITION: f32 = 1.0e6;
 
-/// The largest ratio of two touching dynamic bodies' masses that contacts resolve (10⁶: a
-/// 1 kg box holds 1,000 t, `tests/stress.rs`). Beyond it a contact's impulse, which the heavy
-/// body's weight sets, is so much larger than anything the light body's own motion needs that
-/// f32 rounds away what holds it: a 1 kg box under 10⁷ kg or more is squeezed out or pressed
-/// 0.25–0.95 m into its neighbour with either resolver. Such pairs are not refused (what
-/// touches what is not known in advance) but reported every step they touch
-/// ([`crate::StepReport::beyond_mass_ratio`]).
-pub const MAX_CONTACT_MASS_RATIO: f32 = 1.0e6;
+/// The largest ratio of two touching dynamic bodies' masses whose contacts the soft step
+/// holds (`jostle_resolve::soft_step::MAX_MASS_RATIO`, 10⁶: a 1 kg box under 1,000 t,
+/// `tests/stress.rs`). Beyond it a 1 kg box under 10⁷ kg or more is pressed 0.17–0.95 m into
+/// its neighbour or thrown out, f32 rounding away what holds it; the Millington resolver holds
+/// it (0.3–0.4 mm up to 10¹²). Such pairs are not refused (what touches what is not known in
+/// advance) but reported every step they touch awake, under a resolver that declares the bound
+/// ([`crate::StepReport::beyond_mass_ratio`], `Resolver::max_mass_ratio`).
+pub const MAX_CONTACT_MASS_RATIO: f32 = jostle_resolve::soft_step::MAX_MASS_RATIO;
 
 /// The strongest gravity a scene or snapshot may set (m/s²): 10⁵, ten thousand g (a
 /// scene's `gravity: (0, -1e30, 0)` made its bodies non-finite at the second step).

@@ -83,9 +83,11 @@ pub struct StepReport {
     /// pose within them (it becomes a fixed body) and named here. The rest of the world steps
     /// on.
     pub quarantined: Vec<(BodyHandle, String)>,
-    /// Pairs of dynamic bodies in contact this step whose masses differ by more than
-    /// [`crate::MAX_CONTACT_MASS_RATIO`], lighter first: their contacts cannot hold the light
-    /// body in f32 arithmetic, so it may be pressed deep into its neighbours or squeezed out.
+    /// Pairs of awake dynamic bodies in contact this step whose masses differ by more than the
+    /// resolver's bound (`Resolver::max_mass_ratio`; the soft step's is
+    /// [`crate::MAX_CONTACT_MASS_RATIO`]), lighter first, each once, in handle order: their
+    /// contacts cannot hold the light body in f32 arithmetic, so it may be pressed deep into
+    /// its neighbours or thrown out. Empty under a resolver without such a bound.
     pub beyond_mass_ratio: Vec<(BodyHandle, BodyHandle)>,
 }
 
@@ -1451,6 +1453,12 @@ impl World {
             dt,
             self.settings.gravity,
             &mut self.scratch,
+            &mut report,
+        );
+        stages::report_mass_ratios(
+            self.narrow.contacts(),
+            &self.scratch,
+            self.resolver.max_mass_ratio(),
             &mut report,
         );
         p.gather = t.elapsed();

@@ -206,8 +206,9 @@ pub fn run(args: RunArgs) -> Result<(), String> {
     for (step, light, heavy, ratio) in &summary.beyond_mass_ratio {
         eprintln!(
             "warning: step {step}: body \"{light}\" touches \"{heavy}\", {ratio:.1e} times as \
-             heavy: beyond the mass ratio of {:e} that contacts resolve, the lighter body may \
-             be pressed into its neighbours or squeezed out",
+             heavy: beyond the mass ratio of {:e} that the soft step's contacts hold, the \
+             lighter body may be pressed into its neighbours or thrown out (the Millington \
+             resolver holds it)",
             jostle::MAX_CONTACT_MASS_RATIO
         );
     }

@@ -76,6 +76,13 @@ pub trait Resolver: Send {
     /// Short stable name (`"millington"`, `"soft-step"`), as used on the command line.
     fn name(&self) -> &'static str;
 
+    /// The largest ratio of two touching dynamic bodies' masses whose contacts this resolver
+    /// holds, where it has such a bound (the caller reports pairs beyond it); `None` (the
+    /// default) where none is known.
+    fn max_mass_ratio(&self) -> Option<f32> {
+        None
+    }
+
     /// Advances `bodies` by one step, resolving `contacts`. See the trait's contract.
     fn step(
         &mut self,

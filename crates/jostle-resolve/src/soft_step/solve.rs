@@ -1196,8 +1196,8 @@ fn biased_row<F: Lane, L: LinearResponse<F>>(
 /// explains.
 ///
 /// The soft constraint's impulse is Δλ = −m·s_m·v_n − b − s_i·λ, with b = m·s_m·β·s the bias
-/// (s < 0 on overlap, b clamped to the push-out speed beyond what carries the load below) and
-/// s_i·λ the bleed that makes it a spring. Under a steady load λ the spring settles where the two balance, b = −s_i·λ (s_i·λ
+/// (s < 0 on overlap, b clamped to the push-out speed beyond what carries the load below)
+/// and s_i·λ the bleed that makes it a spring. Under a steady load λ the spring settles where the two balance, b = −s_i·λ (s_i·λ
 /// is exactly the bias of the spring's static compression λ/(h·k)): that much bias is the
 /// spring carrying its load and stays in the real impulse, as in the plain soft step. On a
 /// resting contact (one that carries a load, λ > 0, and approached slower than
