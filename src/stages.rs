@@ -267,15 +267,15 @@ pub(crate) fn report_mass_ratios(
             .map_or(0.0, |b| b.inv_mass)
     };
     // Where no two movable bodies' masses are that far apart, no contact is: the contacts are
-    // not walked (on the 20-row pyramid the walk was 1% of the step).
+    // not walked (on the 20-row pyramid the walk was 1% of the step). The lightest body has
+    // the largest inverse mass; with no movable body the smallest stays infinite.
     let (lightest, heaviest) = scratch
         .bodies
         .iter()
         .filter(|b| b.inv_mass > 0.0 && movable(b))
-        .fold((0.0f32, f32::INFINITY), |(hi, lo), b| {
-            (hi.max(b.inv_mass), lo.min(b.inv_mass))
+        .fold((0.0f32, f32::INFINITY), |(most, least), b| {
+            (most.max(b.inv_mass), least.min(b.inv_mass))
         });
-    // (No movable body: `heaviest` is infinite and nothing is walked.)
     if lightest <= ratio * heaviest {
         return;
     }
