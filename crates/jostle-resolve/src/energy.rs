@@ -24,6 +24,7 @@ pub(crate) fn inertia_of(inv_inertia: Mat3) -> Option<Mat3> {
 }
 
 /// The inverse of a 3 × 3 matrix in f64 (the gyroscopic turn's `turned`, [`inertia_of`]).
+#[derive(Clone, Copy, Debug)]
 pub(crate) struct Inverse64 {
     rows: [[f64; 3]; 3],
     /// The determinant of the matrix inverted.

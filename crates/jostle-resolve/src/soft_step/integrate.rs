@@ -7,8 +7,9 @@
 //! static entry, which is never touched), so that threads can integrate runs of their own.
 
 use super::body_state::{BodyState, EXACT_WARM, FREE, PseudoRow};
-use super::gyroscopic::turn_against;
+use super::gyroscopic::turn_inverted;
 use crate::SolverBody;
+use crate::energy::Inverse64;
 use jostle_math::{Mat3, Quat, Vec3, integrate_orientation};
 
 /// v ← v + g·h for every body of `states` with mass, and each body's share of its applied
@@ -108,6 +109,21 @@ pub fn apply_carried(states: &mut [BodyState], carried: &[Carried]) {
 /// change every substep, and a body that slow turns less than 2.4 mrad per second.
 pub const GYROSCOPIC_CUTOFF: f32 = 1e-5;
 
+/// The gyroscopic term's inputs of [`integrate_positions`], each running along the body
+/// states.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Gyro<'a> {
+    /// Each body's world inertia at the start of the step, zero for a body without one (or
+    /// whose inertia is the same about every axis).
+    pub(crate) inertia: &'a [Mat3],
+    /// The f64 inverse of each body's `inertia`, taken once for the step
+    /// (`gyroscopic::inverse_of`); `None` where there is none.
+    pub(crate) inverse: &'a [Option<Inverse64>],
+    /// The step-start world inverse inertia each body's contact rows use, zero for a body
+    /// without contact rows.
+    pub(crate) rows_inverse: &'a [Mat3],
+}
+
 /// For every body of `states`, `pseudo` theirs: Δx ← Δx + (v + v̂)·h and Δq ← Δq rotated by
 /// ω·h ([`integrate_orientation`], which acts in world space, so Δq·q₀ is exactly the orientation integrated directly), then by the pseudo
 /// rotation ω̂·h, with v̂, ω̂ the pseudo velocities of `pseudo` ([`PseudoRow`]), which are then
@@ -118,21 +134,21 @@ pub const GYROSCOPIC_CUTOFF: f32 = 1e-5;
 /// Left in world space, ω would meet an inertia tensor turned under it (a box spinning at
 /// 10 rad/s pushed out of the floor gained 2.8% of its energy that way).
 ///
-/// With `gyro` (each body's world inertia at the start of the step, zero for a body without
-/// one; and the step-start world inverse inertia its contact rows use, zero for a body
-/// without contact rows) this is also where the gyroscopic term acts
+/// With `gyro` ([`Gyro`]) this is also where the gyroscopic term acts
 /// (`gyroscopic::turn_against`): a body that turns by at least
 /// [`GYROSCOPIC_CUTOFF`] keeps its world angular momentum L = I·ω through the turn, its ω
 /// recomputed from L at the new orientation, unless its inertia has turned too far from the
 /// one its contact rows use.
-pub fn integrate_positions(
+pub(crate) fn integrate_positions(
     states: &mut [BodyState],
     pseudo: &mut [PseudoRow],
-    gyro: Option<(&[Mat3], &[Mat3])>,
+    gyro: Option<Gyro<'_>>,
     h: f32,
 ) {
     debug_assert_eq!(states.len(), pseudo.len());
-    debug_assert!(gyro.is_none_or(|(i, r)| i.len() == states.len() && r.len() == states.len()));
+    debug_assert!(gyro.is_none_or(|g| g.inertia.len() == states.len()
+        && g.inverse.len() == states.len()
+        && g.rows_inverse.len() == states.len()));
     for (k, (s, p)) in states.iter_mut().zip(pseudo.iter_mut()).enumerate() {
         if s.flags & FREE != 0 {
             // No contact row writes its pseudo velocities: the row stays zero.
@@ -143,11 +159,16 @@ pub fn integrate_positions(
         *p = [0.0; 8];
         s.delta_position += (s.linear_velocity + linear) * h;
         if s.rotates() {
-            let (i0, rows) = gyro.map_or((Mat3::ZERO, Mat3::ZERO), |(i, r)| (i[k], r[k]));
             let turn_sq = s.angular_velocity.length_squared() * (h * h);
-            let carried = (i0 != Mat3::ZERO && turn_sq >= GYROSCOPIC_CUTOFF * GYROSCOPIC_CUTOFF)
-                .then(|| turn_against(i0, rows, s.delta_rotation, s.angular_velocity, h))
-                .flatten();
+            let carried = gyro
+                .filter(|g| {
+                    g.inertia[k] != Mat3::ZERO && turn_sq >= GYROSCOPIC_CUTOFF * GYROSCOPIC_CUTOFF
+                })
+                .and_then(|g| {
+                    let inverse = g.inverse[k].as_ref()?;
+                    let (i0, rows) = (g.inertia[k], g.rows_inverse[k]);
+                    turn_inverted(i0, inverse, rows, s.delta_rotation, s.angular_velocity, h)
+                });
             let moved = match carried {
                 Some((after, omega)) => {
                     s.angular_velocity = omega;

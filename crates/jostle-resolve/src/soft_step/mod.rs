@@ -164,6 +164,8 @@ pub struct SoftStepResolver {
     /// angular; [`SolverBody::force_velocity`]); empty when no body has any.
     pushes: Vec<[jostle_math::Vec3; 2]>,
     inertia: Vec<Mat3>,
+    /// The f64 inverse of each body's `inertia`, for its turns (`gyroscopic::inverse_of`).
+    inertia_inverse: Vec<Option<crate::energy::Inverse64>>,
     /// With the gyroscopic term: each body's step-start world inverse inertia if some contact
     /// of the step involves it, else zero (`gyroscopic::turn_against`).
     rows_inverse: Vec<Mat3>,
@@ -362,6 +364,12 @@ impl SoftStepResolver {
                 *i = Mat3::ZERO;
             }
         }
+        self.inertia_inverse.clear();
+        self.inertia_inverse.extend(self.inertia.iter().map(|&i| {
+            (i != Mat3::ZERO)
+                .then(|| gyroscopic::inverse_of(i))
+                .flatten()
+        }));
     }
 
     /// Marks [`body_state::FREE`] the bodies in no batch, not turning and without forces:
@@ -906,6 +914,8 @@ struct Substeps<'a> {
     /// [`SoftStepResolver::pushes`].
     pushes: &'a [[Vec3; 2]],
     inertia: &'a [Mat3],
+    /// [`SoftStepResolver::inertia_inverse`].
+    inertia_inverse: &'a [Option<crate::energy::Inverse64>],
     /// [`SoftStepResolver::rows_inverse`].
     rows_inverse: &'a [Mat3],
     gyroscopic: bool,
@@ -991,11 +1001,10 @@ impl Substeps<'_> {
                     let carried = unsafe { slice_mut(self.carried, range.clone()) };
                     // What the biased pass changed.
                     integrate::collect(states, carried);
-                    let gyro = self.gyroscopic.then(|| {
-                        (
-                            &self.inertia[range.clone()],
-                            &self.rows_inverse[range.clone()],
-                        )
+                    let gyro = self.gyroscopic.then(|| integrate::Gyro {
+                        inertia: &self.inertia[range.clone()],
+                        inverse: &self.inertia_inverse[range.clone()],
+                        rows_inverse: &self.rows_inverse[range.clone()],
                     });
                     integrate::integrate_positions(states, pseudo, gyro, self.h);
                     integrate::mark(states, carried);
@@ -1233,6 +1242,7 @@ impl Resolver for SoftStepResolver {
                 exact_warm,
                 pushes: &self.pushes,
                 inertia: &self.inertia,
+                inertia_inverse: &self.inertia_inverse,
                 rows_inverse: &self.rows_inverse,
                 gyroscopic: self.settings.gyroscopic,
                 direct: share_one(&mut self.direct),
