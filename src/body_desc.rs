@@ -179,22 +179,32 @@ pub enum Kinematic {
     },
 }
 
+/// `Ok` when `value` is at most `limit`, else `field` with a message: "`what` `value`
+/// `unit`, above the limit of `limit` `unit`" (the limits of scene bodies and of snapshot
+/// bodies read the same way).
+pub(crate) fn at_most(
+    field: &'static str,
+    what: &str,
+    value: f32,
+    limit: f32,
+    unit: &str,
+) -> Result<(), (&'static str, String)> {
+    if value <= limit {
+        Ok(())
+    } else {
+        Err((
+            field,
+            format!("{what} {value:.3e} {unit}, above the limit of {limit:e} {unit}"),
+        ))
+    }
+}
+
 /// A kinematic path held to the limits a body is held to: every pose within
 /// [`MAX_POSITION`] of the origin on each axis, its speed within [`MAX_SPEED`] and its spin
 /// within [`MAX_ANGULAR_SPEED`] (`Line(offset: (1e30, 0, 0), period: 1.0)` was accepted and
 /// moved its body at 2.8·10³⁰ m/s). Call after [`KinematicPath::check`]; the error is (field,
 /// message).
 pub(crate) fn path_within_limits(path: &KinematicPath) -> Result<(), (&'static str, String)> {
-    let beyond = |field, what: &str, value: f32, limit: f32, unit: &str| {
-        if value <= limit {
-            Ok(())
-        } else {
-            Err((
-                field,
-                format!("{what} {value:.3e} {unit}, above the limit of {limit:e} {unit}"),
-            ))
-        }
-    };
     match *path {
         KinematicPath::Line {
             start,
@@ -203,7 +213,7 @@ pub(crate) fn path_within_limits(path: &KinematicPath) -> Result<(), (&'static s
             ..
         } => {
             let far = start.abs().max((start + offset).abs()).max_element();
-            beyond(
+            at_most(
                 "offset",
                 "takes the body",
                 far,
@@ -212,7 +222,7 @@ pub(crate) fn path_within_limits(path: &KinematicPath) -> Result<(), (&'static s
             )?;
             // start + offset·(1 − cos(2πt/T))/2: the fastest at π·|offset|/T.
             let speed = std::f32::consts::PI * offset.length() / period;
-            beyond("period", "moves the body at up to", speed, MAX_SPEED, "m/s")
+            at_most("period", "moves the body at up to", speed, MAX_SPEED, "m/s")
         }
         KinematicPath::Turn {
             start,
@@ -227,7 +237,7 @@ pub(crate) fn path_within_limits(path: &KinematicPath) -> Result<(), (&'static s
                 .abs()
                 .max_element()
                 + arm.length();
-            beyond(
+            at_most(
                 "center",
                 "takes the body",
                 far,
@@ -235,14 +245,14 @@ pub(crate) fn path_within_limits(path: &KinematicPath) -> Result<(), (&'static s
                 "m from the origin",
             )?;
             let spin = std::f32::consts::TAU / period.abs();
-            beyond(
+            at_most(
                 "period",
                 "turns the body at",
                 spin,
                 MAX_ANGULAR_SPEED,
                 "rad/s",
             )?;
-            beyond(
+            at_most(
                 "period",
                 "moves the body at",
                 spin * arm.length(),

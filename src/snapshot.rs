@@ -243,14 +243,7 @@ mod file {
     ) -> Result<(), (&'static str, String)> {
         use crate::{MAX_ANGULAR_SPEED, MAX_MASS, MAX_POSITION, MAX_SPEED};
         let check = |field, magnitude: f32, limit: f32, unit| {
-            if magnitude <= limit {
-                Ok(())
-            } else {
-                Err((
-                    field,
-                    format!("{magnitude:.3e} {unit} is above the limit of {limit:e} {unit}"),
-                ))
-            }
+            crate::body_desc::at_most(field, "is", magnitude, limit, unit)
         };
         check(
             "position",

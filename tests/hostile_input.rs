@@ -284,7 +284,7 @@ fn api_values_beyond_the_limits_are_refused() {
 fn a_body_that_leaves_the_limits_is_frozen_and_its_snapshot_reads_back() {
     // A ball thrown at 99,999 m/s with steps of 1 s: 1.1·10⁶ m out after 11 steps, beyond the
     // 10⁶ m a scene's body is held to. It went on to 10⁸ m unreported, and the snapshot
-    // written of it was refused on loading ("position: 1.100e6 m is above the limit").
+    // written of it was refused on loading ("position: is 1.100e6 m, above the limit").
     use jostle::{BodyDesc, ShapeDesc, Vec3, WorldSettings};
     let mut world = World::new(WorldSettings {
         gravity: Vec3::ZERO,
