@@ -325,7 +325,9 @@ impl SoftStepResolver {
 
     /// Loads the body states and, with the gyroscopic term on, the step-start inertia tensors
     /// (zero for a body whose inertia is the same about every axis: a ball or a cube keeps
-    /// L = I·ω with ω itself, and its turns need no term; `gyroscopic::is_isotropic`).
+    /// L = I·ω with ω itself, and its turns need no term, `gyroscopic::is_isotropic`; zero too
+    /// for a body whose moments differ more than f32 world tensors hold,
+    /// `gyroscopic::within_f32`).
     fn load_bodies(&mut self, bodies: &[SolverBody]) {
         self.states.clear();
         self.states.extend(bodies.iter().map(BodyState::from_body));
@@ -355,7 +357,9 @@ impl SoftStepResolver {
         if self.settings.gyroscopic {
             self.inertia.extend(bodies.iter().map(|b| {
                 if b.rotates() && !gyroscopic::is_isotropic(b.inv_inertia) {
-                    gyroscopic::inertia_of(b.inv_inertia).unwrap_or(Mat3::ZERO)
+                    gyroscopic::inertia_of(b.inv_inertia)
+                        .filter(|&i| gyroscopic::within_f32(i, b.inv_inertia))
+                        .unwrap_or(Mat3::ZERO)
                 } else {
                     Mat3::ZERO
                 }
@@ -855,6 +859,27 @@ pub const PARALLEL_MIN_BATCHES: usize = 32;
 /// (The Millington resolver's shock sweep holds such a box: 0.3–0.4 mm up to 10¹².)
 pub const MAX_MASS_RATIO: f32 = 1.0e6;
 
+/// Gravity (m/s², standard gravity) up to which [`SoftStepSettings::max_push_out`] is the
+/// push-out speed as set; beyond it the speed grows in proportion to |g| ([`push_out_speed`]).
+pub const PUSH_OUT_GRAVITY: f32 = 9.81;
+
+/// The push-out speed (m/s) of a step under gravity of magnitude `gravity` (m/s²):
+/// `max_push_out` up to [`PUSH_OUT_GRAVITY`], `max_push_out`·|g|/[`PUSH_OUT_GRAVITY`] beyond.
+///
+/// The bias that holds a resting contact against its load grows with gravity (a unit box on
+/// the ground needs about 0.041·|g|·h of it at the default substeps: 8.6 m/s at 10⁵ m/s²),
+/// and the push-out cap bounds it too: at a fixed 3 m/s such a box sank 38 m in 10 s under
+/// 10⁵ m/s². Scaled, a contact carries the same number of boxes' weight under any gravity
+/// as under Earth's. Capping only the push beyond the load instead held the box but let a box
+/// crushed between two closing kinematic walls ratchet its load up and leave at 31 m/s.
+pub fn push_out_speed(max_push_out: f32, gravity: f32) -> f32 {
+    if gravity > PUSH_OUT_GRAVITY {
+        max_push_out * (gravity / PUSH_OUT_GRAVITY)
+    } else {
+        max_push_out
+    }
+}
+
 /// Mass ratio of a manifold's two movable bodies from which both keep their warm start
 /// point by point in every substep ([`body_state::EXACT_WARM`]) instead of carrying it
 /// ([`integrate::Carried`]). At 1:100 the light body's velocity swings by about 100·|g|·h
@@ -1198,7 +1223,7 @@ impl Resolver for SoftStepResolver {
         stats.direct_rows = u32::try_from(self.direct.rows()).unwrap_or(u32::MAX);
         stats.prepare_time = start.elapsed();
 
-        let push_out = self.settings.max_push_out;
+        let push_out = push_out_speed(self.settings.max_push_out, ctx.gravity.length());
         let rigid = self.settings.rigid_contacts;
         // The relax pass sweeps a manifold's normal rows several times with rigid contacts
         // only; the biased pass also sweeps them at an impact (`solve::BiasedPass::sweeps`).

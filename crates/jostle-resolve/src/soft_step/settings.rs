@@ -49,10 +49,12 @@ pub struct SoftStepSettings {
     /// lets the 40- and 60-columns sink more than 1 mm per layer (the preload's stiffening is
     /// bounded by the damping it leaves) and two perturbed 20-columns sway 11–13 mm.
     pub damping_ratio: f32,
-    /// Largest speed at which the soft bias pushes overlapping bodies apart (m/s), beyond
-    /// what the contact's spring needs to carry its load. Default 3. Bounds the energy a deep
-    /// overlap can inject; the load is not bounded by it (a unit box resting under 10⁵ m/s² of
-    /// gravity needs 8.6 m/s of bias to be held at the default substeps).
+    /// Largest speed at which the soft bias pushes overlapping bodies apart (m/s), under
+    /// gravity up to [`super::PUSH_OUT_GRAVITY`] (9.81 m/s²); under stronger gravity it
+    /// grows in proportion ([`super::push_out_speed`]), since the bias that carries a
+    /// contact's load does (a unit box resting under 10⁵ m/s² needs 8.6 m/s of it at the
+    /// default substeps). Default 3. Bounds the energy a deep overlap or a crushed body can
+    /// gain.
     pub max_push_out: f32,
     /// Overlap (m) beyond its spring's static compression under its current load (and beyond
     /// the one substep of gravity by which the discrete spring's equilibrium sits deeper) that

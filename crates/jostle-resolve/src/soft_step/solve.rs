@@ -1015,7 +1015,8 @@ fn relax_point<F: Lane, L: LinearResponse<F>>(
 pub struct BiasedPass {
     /// 1/substep (1/s).
     pub inv_h: f32,
-    /// Largest push-out speed of the soft bias (m/s).
+    /// Largest push-out speed of the soft bias (m/s): [`super::SoftStepSettings::max_push_out`]
+    /// scaled by gravity beyond [`super::PUSH_OUT_GRAVITY`] ([`super::push_out_speed`]).
     pub max_push_out: f32,
     /// Overlap (m) beyond a resting contact's static compression still pushed out through
     /// real velocity ([`super::SoftStepSettings::push_out_slop`]); with `rigid`, the overlap
@@ -1164,12 +1165,13 @@ fn biased_row<F: Lane, L: LinearResponse<F>>(
     let spring = F::select(speculative, s, s - extra);
     let resting = p.normal_impulse.cmpgt(F::ZERO) & c.resting_speed.cmplt(p.relative_velocity);
     let allowance = F::select(resting, p.bias_rate * c.slop + c.gravity_speed, F::ZERO);
-    // What of the bias carries the load, and the push-out speed's cap on the rest: capping
-    // the whole bias instead let a load whose spring needs more than the cap to hold it sink
-    // without end (a unit box resting under 10⁵ m/s² of gravity sank 38 m in 10 s: its
-    // spring needs 0.041·|g|·h, 8.6 m/s, to carry it at the default substeps).
+    // The whole bias is capped at the push-out speed (which the resolver scales with
+    // gravity beyond Earth's, `BiasedPass::max_push_out`): a cap on only the push beyond the
+    // load let a box crushed between two closing kinematic walls ratchet its springs' load
+    // up step after step, and it left at 31 m/s (benches/RESULTS.md, "A crushed box thrown
+    // out").
+    let bias = soft_mass * (p.bias_rate * spring).max(c.push_out);
     let load = -bleed - soft_mass * allowance;
-    let bias = (soft_mass * (p.bias_rate * spring)).max(load + soft_mass * c.push_out);
     let vn = pair.relative_velocity(p).dot(p.normal);
     let carried = bias.max(load);
     let excess = F::select(speculative, F::ZERO, bias - carried);
@@ -1196,7 +1198,7 @@ fn biased_row<F: Lane, L: LinearResponse<F>>(
 /// explains.
 ///
 /// The soft constraint's impulse is Δλ = −m·s_m·v_n − b − s_i·λ, with b = m·s_m·β·s the bias (s <
-/// 0 on overlap, b clamped to the push-out speed beyond what carries the load below) and s_i·λ
+/// 0 on overlap, b clamped to the push-out speed) and s_i·λ
 /// the bleed that makes it a spring. Under a steady load λ the spring settles where the two
 /// balance, b = −s_i·λ (s_i·λ is exactly the bias of the spring's static compression λ/(h·k)):
 /// that much bias is the spring carrying its load and stays in the real impulse, as in the plain
