@@ -162,10 +162,18 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
             case.setting.label
         ));
         let overrides = Overrides {
-            resolver: Some(case.setting.resolver.clone()),
+            resolver: None,
             sleep: args.no_sleep.then_some(false),
         };
         let mut setup = load(&case.path, &overrides).map_err(|e| e.to_string())?;
+        // The case's resolver exactly as the sweep set it (it starts from the scene's own
+        // settings where the scene names the same resolver). As an override it was dropped
+        // wherever the scene named the same resolver, so a sweep of the default soft step's
+        // substeps or relax iterations ran its defaults at every level.
+        setup
+            .world
+            .set_resolver_choice(case.setting.resolver.clone())
+            .map_err(|e| format!("{}: {e}", case.path.display()))?;
         let settle = args.settle.min(case.duration / 2.0);
         let metrics = run_case(
             &mut setup.world,
