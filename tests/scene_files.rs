@@ -272,11 +272,15 @@ fn generators_that_would_exhaust_memory_are_errors() {
     let e = error("Scene(generators: [Piles(nx: 100000, nz: 100000, height: 100000)])");
     let text = e.to_string();
     assert!(
-        text.contains("generators[0].count") && text.contains("1000000000000000 bodies"),
+        text.contains("generators[0].nx") && text.contains("1000000000000000 bodies"),
         "{e}"
     );
-    // A 100,000-row pyramid is 5·10⁹ boxes; 1,000 rows (500,500) is fine.
-    assert!(Scene::parse("Scene(generators: [Pyramid(rows: 100000)])", "p.ron").is_err());
+    // A 100,000-row pyramid is 5·10⁹ boxes, named by its own field (it was `count`, which a
+    // pyramid does not have); 1,000 rows (500,500) is fine.
+    let e = error("Scene(generators: [Pyramid(rows: 100000)])");
+    assert!(e.to_string().contains("generators[0].rows"), "{e}");
+    let e = error("Scene(generators: [Pyramid3D(layers: 1000)])");
+    assert!(e.to_string().contains("generators[0].layers"), "{e}");
     assert!(Scene::parse("Scene(generators: [Pyramid(rows: 1000)])", "p.ron").is_ok());
     // Within the bound one by one, beyond it together: two of 500,500 boxes.
     let e = error(
@@ -425,6 +429,18 @@ fn duplicate_body_names_are_refused() {
         "unnamed.ron",
     );
     assert!(scene.is_ok(), "{:?}", scene.err());
+    // Two unnamed generators of one kind make the same names: the error says how to tell
+    // them apart.
+    let scene = Scene::parse(
+        "Scene(generators: [Stack(count: 2), Stack(count: 2, origin: (3.0, 0.0, 0.0))])",
+        "stacks.ron",
+    )
+    .expect("parses");
+    let e = scene.build().err().expect("refused").to_string();
+    assert!(
+        e.contains("stack-0") && e.contains("give each generator of the same kind its own `name:`"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -197,8 +197,17 @@ impl Generator {
         self.validate_parameters()?;
         let n = self.body_count();
         if n > Self::MAX_BODIES {
+            // The field that sets the count (`Pyramid(rows: 100000)` was reported as
+            // `count`, which a pyramid does not have).
+            let field = match self {
+                Self::Pyramid { .. } => "rows",
+                Self::Pyramid3D { .. } => "layers",
+                Self::Stack { .. } => "count",
+                Self::Wall { .. } => "columns",
+                Self::Piles { .. } => "nx",
+            };
             return Err((
-                "count".into(),
+                field.into(),
                 format!(
                     "makes {n} bodies, more than the {} one generator may make",
                     Self::MAX_BODIES

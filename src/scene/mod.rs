@@ -455,7 +455,7 @@ impl Scene {
             })?;
         }
         let names: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
-        unique_names(&names)?;
+        unique_names(&names, names.len())?;
         for (i, g) in self.generators.iter().enumerate() {
             g.validate().map_err(|(field, message)| {
                 setting(&format!("generators[{i}].{field}"), message)
@@ -538,7 +538,7 @@ impl Scene {
             p.apply(&mut out[first_generated..]);
         }
         let names: Vec<&str> = out.iter().map(|d| d.name.as_str()).collect();
-        unique_names(&names)?;
+        unique_names(&names, first_generated)?;
         Ok(out)
     }
 
@@ -564,7 +564,9 @@ impl Scene {
 
 /// Refuses two bodies of one name: names are how errors, traces and snapshots tell bodies
 /// apart, and a repeated one would make each of those ambiguous.
-fn unique_names(names: &[&str]) -> Result<(), SceneError> {
+/// Bodies from `first_generated` on were made by generators: a clash among them names the
+/// generators' `name` field, which sets the prefix of the bodies' names.
+fn unique_names(names: &[&str], first_generated: usize) -> Result<(), SceneError> {
     let mut seen = std::collections::HashMap::with_capacity(names.len());
     // Bodies without a name (the default) are known by their place, not by name: several may
     // go unnamed (two were refused as having the same name "").
@@ -577,9 +579,15 @@ fn unique_names(names: &[&str]) -> Result<(), SceneError> {
                 error: BodyError::Field {
                     body: name.to_string(),
                     field: "name".into(),
-                    message: format!(
-                        "body {i} has the same name as body {first}; names must be unique"
-                    ),
+                    message: if first >= first_generated {
+                        format!(
+                            "body {i} has the same name as body {first}; names must be unique \
+                             (both are generated: give each generator of the same kind its own \
+                             `name:`)"
+                        )
+                    } else {
+                        format!("body {i} has the same name as body {first}; names must be unique")
+                    },
                 },
             });
         }

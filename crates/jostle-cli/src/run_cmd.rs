@@ -29,7 +29,7 @@ pub struct RunArgs {
     /// names the same resolver keeps its settings for it.
     #[arg(long)]
     resolver: Option<String>,
-    /// Write a CSV trace of every dynamic body to this file.
+    /// Write a CSV trace of every body that is not fixed (dynamic and kinematic) to this file.
     #[arg(long, value_name = "FILE.csv")]
     trace: Option<PathBuf>,
     /// Trace every K-th step (steps 0 and the last are always written).
@@ -368,13 +368,14 @@ fn table_text(scene: &str, resolver: &str, dt: f32, bodies: usize, s: &RunSummar
             .map(|(n, t)| (format!("  {n} (median ms)"), format!("{:.3}", ms(*t)))),
     )
     .chain([
+        // (`+ 0.0` prints an empty scene's negative-zero sum as 0.)
         (
             "kinetic energy start (J)".into(),
-            format!("{:.6}", s.kinetic_energy_initial),
+            format!("{:.6}", s.kinetic_energy_initial + 0.0),
         ),
         (
             "kinetic energy end (J)".into(),
-            format!("{:.6}", s.kinetic_energy_final),
+            format!("{:.6}", s.kinetic_energy_final + 0.0),
         ),
         (
             "largest penetration, last step (m)".into(),

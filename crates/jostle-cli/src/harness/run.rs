@@ -8,7 +8,7 @@ use std::time::Duration;
 /// The header of a trace file, exactly.
 pub const TRACE_HEADER: &str = "step,time,body,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz,awake";
 
-/// Writes one CSV row per dynamic body: the state of `world` now, labelled with the world's own
+/// Writes one CSV row per body that is not fixed (dynamic and kinematic): the state of `world` now, labelled with the world's own
 /// step count and simulated time, so a run continued from a snapshot numbers its rows as the
 /// uninterrupted run does. Numbers are printed in Rust's shortest round-trip form, so a trace
 /// is bit-exact.
