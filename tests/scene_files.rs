@@ -486,6 +486,14 @@ fn two_confusing_parse_errors_carry_a_hint() {
             "{text}: {e}"
         );
     }
+    // A resolver's settings in double parentheses (ron said "Expected identifier").
+    for text in [
+        "Scene(resolver: SoftStep((substeps: 4)))",
+        "Scene(resolver: Millington((velocity_iterations: 4)))",
+    ] {
+        let e = error(text).to_string();
+        assert!(e.contains("in one pair of parentheses"), "{text}: {e}");
+    }
 }
 
 #[test]

@@ -277,9 +277,11 @@ fn locate_setting(text: &str, field: &str) -> Option<(usize, usize)> {
     Some(line_column(text, at))
 }
 
-/// A hint for two of ron's messages that do not say what is wrong: a fraction where a whole
-/// number is expected (`steps: 10.5` is read as 10 followed by `.5`: "Expected comma"), and
-/// an optional setting written with its type (`sleep: Some(SleepSettings(...))`).
+/// A hint for three of ron's messages that do not say what is wrong: a fraction where a
+/// whole number is expected (`steps: 10.5` is read as 10 followed by `.5`: "Expected comma"),
+/// an optional setting written with its type (`sleep: Some(SleepSettings(...))`), and a
+/// resolver's settings in double parentheses (`SoftStep((substeps: 4))`: "Expected
+/// identifier").
 fn hint(text: &str, line: usize, column: usize, message: &str) -> Option<&'static str> {
     let offset = byte_offset(text, line, column);
     let here = text.get(offset.min(text.len())..)?;
@@ -304,6 +306,15 @@ fn hint(text: &str, line: usize, column: usize, message: &str) -> Option<&'stati
         return Some(
             "write the settings' fields in parentheses, without `Some` or the type's name: \
              `sleep: (enabled: false)`, `camera: (position: (0.0, 5.0, 10.0))`",
+        );
+    }
+    // A resolver's settings in double parentheses (`SoftStep((substeps: 4))`, the form an
+    // environment variable of the test harness takes): ron reads the inner `(` as an
+    // identifier missing.
+    if line.contains("SoftStep((") || line.contains("Millington((") {
+        return Some(
+            "write the resolver's settings in one pair of parentheses: \
+             `resolver: SoftStep(substeps: 4)`",
         );
     }
     None

@@ -56,12 +56,60 @@ fn csv_field(s: &str) -> String {
     }
 }
 
+/// Most values a [`Sampled`] series keeps.
+pub const SAMPLE_CAP: usize = 1 << 16;
+
+/// A long series kept in bounded memory: every value while there are at most [`SAMPLE_CAP`],
+/// then every second one, every fourth, and so on (a uniform subsample in order), so that a
+/// run's memory does not grow with its steps (`--steps 6000000` held 990 MB of per-step
+/// times). Medians over it are those of the subsample.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Sampled<T> {
+    values: Vec<T>,
+    /// Every `stride`-th value is kept (a power of two; 0 before the first value).
+    stride: u64,
+    /// Values offered so far.
+    seen: u64,
+}
+
+impl<T: Copy> Sampled<T> {
+    /// Offers the next value of the series.
+    pub fn push(&mut self, value: T) {
+        self.stride = self.stride.max(1);
+        let index = self.seen;
+        self.seen += 1;
+        if index % self.stride != 0 {
+            return;
+        }
+        if self.values.len() >= SAMPLE_CAP {
+            // Keep every second value: those at the doubled stride.
+            let mut kept = 0;
+            for i in (0..self.values.len()).step_by(2) {
+                self.values[kept] = self.values[i];
+                kept += 1;
+            }
+            self.values.truncate(kept);
+            self.stride *= 2;
+            if index % self.stride != 0 {
+                return;
+            }
+        }
+        self.values.push(value);
+    }
+
+    /// The values kept, in order.
+    pub fn values(&self) -> &[T] {
+        &self.values
+    }
+}
+
 /// What a run measured.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct RunSummary {
     /// Steps taken.
     pub steps: u64,
-    /// Wall time of each step.
+    /// Wall time of each step; beyond [`SAMPLE_CAP`] steps, of a uniform subsample of them
+    /// ([`Sampled`]).
     pub step_times: Vec<Duration>,
     /// Median wall time of each stage over the run, in pipeline order.
     pub stage_medians: Vec<(&'static str, Duration)>,
@@ -130,14 +178,15 @@ pub fn run(
         kinetic_energy_initial: world.kinetic_energy(),
         ..Default::default()
     };
-    // Reserved for at most 65,536 steps: reserving `steps` up front made `--steps 4000000000`
-    // abort on a 64 GB allocation before the first step. Longer runs grow as they go.
-    let reserve = steps.min(1 << 16) as usize;
-    let mut stage_times: Vec<Vec<Duration>> = (0..jostle::StepProfile::STAGES)
-        .map(|_| Vec::with_capacity(reserve))
+    // Bounded series: reserving `steps` up front made `--steps 4000000000` abort on a 64 GB
+    // allocation before the first step, and growing with the steps held 165 bytes a step.
+    let mut step_times = Sampled::default();
+    let mut stage_times: Vec<Sampled<Duration>> = (0..jostle::StepProfile::STAGES)
+        .map(|_| Sampled::default())
         .collect();
     let dynamic = world.bodies().filter(|(_, _, b)| !b.is_fixed()).count();
-    let mut residuals: [Vec<f32>; 2] = [Vec::with_capacity(reserve), Vec::with_capacity(reserve)];
+    let mut residuals: [Sampled<f32>; 2] = [Sampled::default(), Sampled::default()];
+    let mut residual_max = [0.0f32; 2];
     let mut picks = [0u64; 2];
     let mut direct_rows = 0u64;
     let mut seen_ratios = std::collections::HashSet::new();
@@ -155,14 +204,19 @@ pub fn run(
             }
         }
         let p = world.profile();
-        s.step_times.push(p.total);
+        step_times.push(p.total);
         let r = &p.resolve_stats;
         picks[0] += u64::from(r.position_iterations);
         picks[1] += u64::from(r.velocity_iterations);
         direct_rows += u64::from(r.direct_rows);
         s.team_steps += u64::from(r.threads > 1);
-        residuals[0].push(r.position_residual);
-        residuals[1].push(r.velocity_residual);
+        for (pass, residual) in [r.position_residual, r.velocity_residual]
+            .into_iter()
+            .enumerate()
+        {
+            residuals[pass].push(residual);
+            residual_max[pass] = residual_max[pass].max(residual);
+        }
         for (i, (_, t)) in p.stages().iter().enumerate() {
             stage_times[i].push(*t);
         }
@@ -179,16 +233,17 @@ pub fn run(
     s.direct_rows_per_step = direct_rows as f64 / steps.max(1) as f64;
     for pass in 0..2 {
         s.picks_per_step[pass] = picks[pass] as f64 / steps.max(1) as f64;
-        let v = &mut residuals[pass];
+        let mut v = residuals[pass].values().to_vec();
         v.sort_unstable_by(f32::total_cmp);
         s.residual_median[pass] = v.get(v.len() / 2).copied().unwrap_or(0.0);
-        s.residual_max[pass] = v.last().copied().unwrap_or(0.0);
+        s.residual_max[pass] = residual_max[pass];
     }
+    s.step_times = step_times.values().to_vec();
     let names = world.profile().stages().map(|(n, _)| n);
     s.stage_medians = names
         .iter()
         .zip(&stage_times)
-        .map(|(n, t)| (*n, median(t)))
+        .map(|(n, t)| (*n, median(t.values())))
         .collect();
     s.kinetic_energy_final = world.kinetic_energy();
     s.max_penetration_final = world.max_penetration();
@@ -338,6 +393,37 @@ mod tests {
     /// The summary reports what the Millington resolver's passes left unresolved: a column of
     /// ten boxes with a budget of one velocity pick per contact leaves more than the epsilon
     /// (the stack is not resolved), the default budget on one box leaves nothing above it.
+    /// A long series keeps at most `SAMPLE_CAP` values, evenly spaced over all of it.
+    #[test]
+    fn a_sampled_series_stays_bounded_and_uniform() {
+        let mut series = Sampled::default();
+        let n = 5 * SAMPLE_CAP as u64 + 3;
+        for i in 0..n {
+            series.push(i);
+        }
+        let kept = series.values();
+        assert!(
+            kept.len() <= SAMPLE_CAP && kept.len() > SAMPLE_CAP / 2,
+            "{}",
+            kept.len()
+        );
+        let stride = kept[1] - kept[0];
+        assert!(stride.is_power_of_two() && stride > 1);
+        assert!(
+            kept.iter()
+                .enumerate()
+                .all(|(k, &v)| v == k as u64 * stride)
+        );
+        assert!(
+            n - 1 - kept[kept.len() - 1] < stride,
+            "the last kept is within a stride of the end"
+        );
+        // Short series keep every value.
+        let mut short = Sampled::default();
+        (0..10u64).for_each(|i| short.push(i));
+        assert_eq!(short.values(), (0..10).collect::<Vec<_>>().as_slice());
+    }
+
     #[test]
     fn the_summary_reports_picks_and_what_the_passes_left() {
         let run_scene = |text: &str| {
