@@ -78,7 +78,7 @@ impl<T: Copy> Sampled<T> {
         self.stride = self.stride.max(1);
         let index = self.seen;
         self.seen += 1;
-        if index % self.stride != 0 {
+        if !index.is_multiple_of(self.stride) {
             return;
         }
         if self.values.len() >= SAMPLE_CAP {
@@ -90,7 +90,7 @@ impl<T: Copy> Sampled<T> {
             }
             self.values.truncate(kept);
             self.stride *= 2;
-            if index % self.stride != 0 {
+            if !index.is_multiple_of(self.stride) {
                 return;
             }
         }
