@@ -32,8 +32,8 @@ pub struct RunArgs {
     /// Write a CSV trace of every body that is not fixed (dynamic and kinematic) to this file.
     #[arg(long, value_name = "FILE.csv")]
     trace: Option<PathBuf>,
-    /// Trace every K-th step (steps 0 and the last are always written).
-    #[arg(long, default_value_t = 1, value_name = "K")]
+    /// Trace every K-th step (steps 0 and the last are always written). Only with --trace.
+    #[arg(long, default_value_t = 1, value_name = "K", requires = "trace")]
     every: u64,
     /// Disable sleeping (every body simulated every step).
     #[arg(long)]

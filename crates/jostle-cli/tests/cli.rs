@@ -315,8 +315,15 @@ fn every_bad_input_exits_non_zero_with_a_precise_message() {
         (
             "zero --every",
             "Scene()".into(),
-            vec!["--every", "0"],
-            &["--every"],
+            vec!["--every", "0", "--trace", "never-written.csv"],
+            &["--every must be at least 1"],
+        ),
+        (
+            // Accepted and ignored before, unlike --fps or --frame-every without --render.
+            "--every without --trace",
+            "Scene()".into(),
+            vec!["--every", "5"],
+            &["--trace"],
         ),
         (
             "unknown resolver",
