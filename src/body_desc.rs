@@ -157,6 +157,8 @@ pub enum Kinematic {
     /// ([`crate::World::set_velocity`]).
     Velocity,
     /// Moved to the poses it is sent to ([`crate::World::set_next_pose`]); at rest otherwise.
+    /// Its velocity follows from those poses: `linear_velocity` and `angular_velocity` must
+    /// be zero (so too for `Line` and `Turn`).
     Position,
     /// Back and forth along `offset` (m) from where it starts, smoothly, there and back once
     /// per `period` (s, > 0) ([`KinematicPath::Line`]).
@@ -463,6 +465,32 @@ impl BodyDesc {
             MAX_ANGULAR_SPEED,
             "rad/s",
         )?;
+        // A body moved to given poses takes its velocity from them: one set here was shown at
+        // step 0 and dropped at the first step.
+        if let Some(
+            kind @ (Kinematic::Position | Kinematic::Line { .. } | Kinematic::Turn { .. }),
+        ) = &self.kinematic
+        {
+            let driven = match kind {
+                Kinematic::Position => "to the poses it is sent",
+                _ => "along its path",
+            };
+            for (field, v) in [
+                ("linear_velocity", self.linear_velocity),
+                ("angular_velocity", self.angular_velocity),
+            ] {
+                if v != Vec3::ZERO {
+                    return Err(err(
+                        field,
+                        format!(
+                            "must be zero for a kinematic body moved {driven}, whose velocity \
+                             follows from its motion (`kinematic: Velocity` moves a body by \
+                             its velocity), got {v}"
+                        ),
+                    ));
+                }
+            }
+        }
         if self.lock_rotation && !self.fixed && self.angular_velocity != Vec3::ZERO {
             return Err(err(
                 "angular_velocity",

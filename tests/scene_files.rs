@@ -526,3 +526,32 @@ fn a_body_without_a_name_is_named_by_its_place_in_the_list() {
         "{message}"
     );
 }
+
+#[test]
+fn a_kinematic_body_moved_by_poses_or_a_path_refuses_a_velocity() {
+    // Shown at step 0 and dropped at the first step before: the poses decide the motion.
+    for kinematic in [
+        "Position",
+        "Line(offset: (1.0, 0.0, 0.0), period: 2.0)",
+        "Turn(center: (0.0, 0.0, 0.0), axis: (0.0, 1.0, 0.0), period: 2.0)",
+    ] {
+        for (field, value) in [
+            ("linear_velocity", "(1.0, 0.0, 0.0)"),
+            ("angular_velocity", "(0.0, 2.0, 0.0)"),
+        ] {
+            let text = format!(
+                "Scene(bodies: [Body(name: \"pad\", shape: Cuboid(half_extents: (0.5, 0.5, 0.5)), \
+                 kinematic: {kinematic}, {field}: {value})])"
+            );
+            let (body, f) = body_field(&text);
+            assert_eq!((body.as_str(), f.as_str()), ("pad", field), "{kinematic}");
+        }
+    }
+    // Moved by its velocity, it takes one.
+    let ok = Scene::parse(
+        "Scene(bodies: [Body(name: \"pad\", shape: Cuboid(half_extents: (0.5, 0.5, 0.5)), \
+         kinematic: Velocity, linear_velocity: (1.0, 0.0, 0.0))])",
+        "ok.ron",
+    );
+    assert!(ok.is_ok(), "{:?}", ok.err());
+}
