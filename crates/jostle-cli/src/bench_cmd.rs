@@ -69,22 +69,31 @@ struct Row {
 }
 
 pub fn run(args: BenchArgs) -> Result<(), String> {
-    let scenes: Vec<PathBuf> = if args.scenes.is_empty() {
+    // Each scene and resolver once, in the order given: named twice, they ran twice and gave
+    // duplicate rows.
+    let mut scenes: Vec<PathBuf> = Vec::new();
+    let given: Vec<PathBuf> = if args.scenes.is_empty() {
         DEFAULT_SCENES.iter().map(PathBuf::from).collect()
     } else {
         args.scenes.clone()
     };
-    let resolvers: Vec<ResolverChoice> = if args.resolvers.is_empty() {
-        ResolverChoice::NAMES
-            .iter()
-            .map(|n| ResolverChoice::from_name(n))
-            .collect::<Result<_, _>>()?
+    for path in given {
+        if !scenes.contains(&path) {
+            scenes.push(path);
+        }
+    }
+    let mut resolvers: Vec<ResolverChoice> = Vec::new();
+    let names: Vec<&str> = if args.resolvers.is_empty() {
+        ResolverChoice::NAMES.to_vec()
     } else {
-        args.resolvers
-            .iter()
-            .map(|n| ResolverChoice::from_name(n))
-            .collect::<Result<_, _>>()?
+        args.resolvers.iter().map(String::as_str).collect()
     };
+    for name in names {
+        let resolver = ResolverChoice::from_name(name)?;
+        if !resolvers.iter().any(|r| r.name() == resolver.name()) {
+            resolvers.push(resolver);
+        }
+    }
     let sweep = args.sweep.as_deref().map(Sweep::from_name).transpose()?;
     if let Some(d) = args.duration
         && !(d.is_finite() && d > 0.0)
