@@ -187,11 +187,12 @@ pub enum Kinematic {
 pub(crate) fn at_most(
     field: &'static str,
     what: &str,
-    value: f32,
+    value: impl Into<f64>,
     limit: f32,
     unit: &str,
 ) -> Result<(), (&'static str, String)> {
-    if value <= limit {
+    let value = value.into();
+    if value <= f64::from(limit) {
         Ok(())
     } else {
         Err((
@@ -433,38 +434,35 @@ impl BodyDesc {
         vec("position", self.position)?;
         vec("linear_velocity", self.linear_velocity)?;
         vec("angular_velocity", self.angular_velocity)?;
-        let at_most = |field: &str, v: Vec3, limit: f32, unit: &str| {
-            let length = v
-                .to_array()
+        // A vector's length in f64, where its square cannot overflow (a velocity of 3·10³⁸).
+        let length = |v: Vec3| {
+            v.to_array()
                 .map(|x| f64::from(x).powi(2))
                 .iter()
                 .sum::<f64>()
-                .sqrt();
-            if length <= f64::from(limit) {
-                Ok(())
-            } else {
-                Err(err(
-                    field,
-                    format!(
-                        "its length {length:.3e} {unit} is above the limit of {limit:e} {unit}"
-                    ),
-                ))
-            }
+                .sqrt()
         };
         let far = self.position.abs().max_element();
-        if far > MAX_POSITION {
-            return Err(err(
-                "position",
-                format!("{far:.3e} m from the origin is beyond the limit of {MAX_POSITION:e} m"),
-            ));
-        }
-        at_most("linear_velocity", self.linear_velocity, MAX_SPEED, "m/s")?;
-        at_most(
-            "angular_velocity",
-            self.angular_velocity,
-            MAX_ANGULAR_SPEED,
-            "rad/s",
-        )?;
+        [
+            at_most("position", "lies", far, MAX_POSITION, "m from the origin"),
+            at_most(
+                "linear_velocity",
+                "has a length of",
+                length(self.linear_velocity),
+                MAX_SPEED,
+                "m/s",
+            ),
+            at_most(
+                "angular_velocity",
+                "has a length of",
+                length(self.angular_velocity),
+                MAX_ANGULAR_SPEED,
+                "rad/s",
+            ),
+        ]
+        .into_iter()
+        .collect::<Result<(), _>>()
+        .map_err(|(field, message)| err(field, message))?;
         // A body moved to given poses takes its velocity from them: one set here was shown at
         // step 0 and dropped at the first step.
         if let Some(

@@ -390,65 +390,61 @@ fn fastest(text: &str, resolver: &ResolverChoice, name: &str) -> (f32, f32) {
 /// (benches/RESULTS.md, "A crushed box thrown out"; `CRUSH_SIZES=0.1,1,10 cargo test --release
 /// --test stress crushed -- --nocapture` prints them and fails).
 #[test]
-fn a_box_crushed_between_walls_leaves_no_faster_than_they_move_and_push_out() {
+fn a_crushed_half_metre_box_leaves_no_faster_than_the_walls_and_push_out() {
     let soft = SoftStepSettings::default();
     let resolver = ResolverChoice::SoftStep(soft.clone());
     let sizes: Vec<f32> = std::env::var("CRUSH_SIZES")
         .map(|v| v.split(',').filter_map(|x| x.parse().ok()).collect())
         .unwrap_or(vec![0.5]);
+    let mut thrown = Vec::new();
     for size in sizes {
         let k = size / 0.5;
         for period in [4.0f32, 20.0] {
             let steps = (period * 0.75 / DT) as u32;
-            let closing = format!(
-                "Scene(name: \"crush\", steps: {steps}, sleep: (enabled: false), bodies: [
-                  Body(name: \"ground\", shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true),
-                  Body(name: \"left\", shape: Cuboid(half_extents: ({w}, {h}, {d})),
-                       position: ({l}, {h}, 0.0), kinematic: Line(offset: ({o}, 0.0, 0.0), period: {period})),
-                  Body(name: \"right\", shape: Cuboid(half_extents: ({w}, {h}, {d})),
-                       position: ({r}, {h}, 0.0), kinematic: Line(offset: ({n}, 0.0, 0.0), period: {period})),
-                  Body(name: \"box\", shape: Cuboid(half_extents: ({b}, {b}, {b})), position: (0.0, {b}, 0.0)),
-                ])",
-                w = 0.1 * k,
-                h = 0.5 * k,
-                d = 1.0 * k,
-                l = -2.0 * k,
-                r = 2.0 * k,
-                o = 2.0 * k,
-                n = -2.0 * k,
-                b = 0.25 * k,
-            );
-            let against_wall = format!(
-                "Scene(name: \"crush\", steps: {steps}, sleep: (enabled: false), bodies: [
-                  Body(name: \"ground\", shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true),
-                  Body(name: \"wall\", shape: Cuboid(half_extents: ({ww}, {h}, {wd})),
-                       position: ({x}, {h}, 0.0), fixed: true),
-                  Body(name: \"pusher\", shape: Cuboid(half_extents: ({w}, {ph}, {d})),
-                       position: ({l}, {ph}, 0.0), kinematic: Line(offset: ({o}, 0.0, 0.0), period: {period})),
-                  Body(name: \"box\", shape: Cuboid(half_extents: ({b}, {b}, {b})), position: (0.0, {b}, 0.0)),
-                ])",
-                ww = 0.2 * k,
-                h = 1.0 * k,
-                wd = 2.0 * k,
-                x = 1.1 * k,
-                w = 0.1 * k,
-                ph = 0.5 * k,
-                d = 1.0 * k,
-                l = -2.0 * k,
-                o = 3.0 * k,
-                b = 0.25 * k,
-            );
+            // A slab of half extents `h` at x, resting on the ground, as scene text.
+            let slab = |name: &str, h: Vec3, x: f32, motion: &str| {
+                format!(
+                    "Body(name: \"{name}\", shape: Cuboid(half_extents: ({}, {}, {})), \
+                     position: ({x}, {}, 0.0), {motion}),",
+                    h.x, h.y, h.z, h.y
+                )
+            };
+            let line = |offset: f32| {
+                format!("kinematic: Line(offset: ({offset}, 0.0, 0.0), period: {period})")
+            };
+            let scene = |walls: [String; 2]| {
+                format!(
+                    "Scene(name: \"crush\", steps: {steps}, sleep: (enabled: false), bodies: [
+                       Body(name: \"ground\", shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true),
+                       {} {} {}])",
+                    walls[0],
+                    walls[1],
+                    slab("box", Vec3::splat(0.25 * k), 0.0, "")
+                )
+            };
+            let mover = Vec3::new(0.1, 0.5, 1.0) * k;
+            let closing = scene([
+                slab("left", mover, -2.0 * k, &line(2.0 * k)),
+                slab("right", mover, 2.0 * k, &line(-2.0 * k)),
+            ]);
+            let against_wall = scene([
+                slab("wall", Vec3::new(0.2, 1.0, 2.0) * k, 1.1 * k, "fixed: true"),
+                slab("pusher", mover, -2.0 * k, &line(3.0 * k)),
+            ]);
             for (kind, text) in [("closing walls", closing), ("against a wall", against_wall)] {
                 let (fastest, mover) = fastest(&text, &resolver, "box");
                 let case = format!("{kind}, {size} m box, period {period} s");
                 println!("{case}: box at most {fastest:.2} m/s, walls {mover:.2} m/s");
-                assert!(
-                    fastest <= mover + soft.max_push_out,
-                    "{case}: the box left at {fastest} m/s, the walls moved at {mover} m/s"
-                );
+                if fastest > mover + soft.max_push_out {
+                    thrown.push(format!(
+                        "{case}: the box left at {fastest} m/s, the walls moved at {mover} m/s"
+                    ));
+                }
             }
         }
     }
+    // Every case first, then the verdict: a run over other sizes prints its whole table.
+    assert!(thrown.is_empty(), "{thrown:#?}");
 }
 
 #[test]

@@ -52,13 +52,6 @@ pub fn within_f32(inertia: Mat3, inv_inertia: Mat3) -> bool {
     spread(inertia, inv_inertia) <= MAX_GYROSCOPIC_SPREAD
 }
 
-/// The f64 inverse of a body's step-start world inertia `inertia` ([`inertia_of`]) that its
-/// turns apply ([`turn_inverted`]); `None` when it cannot be inverted (the body then turns by
-/// ω alone, as [`turn_against`] does).
-pub(crate) fn inverse_of(inertia: Mat3) -> Option<Inverse64> {
-    Inverse64::of(inertia)
-}
-
 /// Whether the world inverse inertia `inv_inertia` is a multiple of the identity to within
 /// [`ISOTROPY_TOLERANCE`] of its diagonal's mean (a ball, a cube, any body whose principal
 /// moments are equal): then L = I·ω turns with ω, ω × I·ω = 0, and the gyroscopic term
@@ -145,7 +138,7 @@ pub fn turn_against(
 }
 
 /// [`turn_against`] with the f64 inverse of `inertia` already taken (`Inverse64::of`): the
-/// soft step takes it once per step for each body ([`inverse_of`]), not in every substep's
+/// soft step takes it once per step for each body (`SoftStepResolver::load_bodies`), not in every substep's
 /// turn (bit for bit the same; on a rain of 1,000 tumbling shapes, 300 steps on one thread,
 /// the turns' instructions fell by 11%, the whole run's by 0.7%).
 pub(crate) fn turn_inverted(

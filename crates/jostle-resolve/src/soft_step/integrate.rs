@@ -113,11 +113,12 @@ pub const GYROSCOPIC_CUTOFF: f32 = 1e-5;
 /// states.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Gyro<'a> {
-    /// Each body's world inertia at the start of the step, zero for a body without one (or
-    /// whose inertia is the same about every axis).
+    /// Each body's world inertia at the start of the step, zero for a body without one, whose
+    /// inertia is the same about every axis, or whose moments f32 cannot hold
+    /// (`gyroscopic::within_f32`).
     pub(crate) inertia: &'a [Mat3],
-    /// The f64 inverse of each body's `inertia`, taken once for the step
-    /// (`gyroscopic::inverse_of`); `None` where there is none.
+    /// The f64 inverse of each body's `inertia`, taken once for the step; `None` where the
+    /// inertia is zero or cannot be inverted (the body then turns by ω alone).
     pub(crate) inverse: &'a [Option<Inverse64>],
     /// The step-start world inverse inertia each body's contact rows use, zero for a body
     /// without contact rows.
@@ -160,10 +161,9 @@ pub(crate) fn integrate_positions(
         s.delta_position += (s.linear_velocity + linear) * h;
         if s.rotates() {
             let turn_sq = s.angular_velocity.length_squared() * (h * h);
+            // (A body without an inertia has no inverse either.)
             let carried = gyro
-                .filter(|g| {
-                    g.inertia[k] != Mat3::ZERO && turn_sq >= GYROSCOPIC_CUTOFF * GYROSCOPIC_CUTOFF
-                })
+                .filter(|_| turn_sq >= GYROSCOPIC_CUTOFF * GYROSCOPIC_CUTOFF)
                 .and_then(|g| {
                     let inverse = g.inverse[k].as_ref()?;
                     let (i0, rows) = (g.inertia[k], g.rows_inverse[k]);

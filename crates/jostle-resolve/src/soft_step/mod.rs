@@ -142,6 +142,7 @@ pub use settings::SoftStepSettings;
 pub use softness::Softness;
 
 use crate::clock::Stopwatch;
+use crate::energy::Inverse64;
 use crate::{Contact, ResolveStats, Resolver, STATIC_BODY, SolverBody, StepContext};
 use batch::{ManifoldLanes, PointLanes};
 use jostle_math::{Mat3, Vec3};
@@ -164,8 +165,9 @@ pub struct SoftStepResolver {
     /// angular; [`SolverBody::force_velocity`]); empty when no body has any.
     pushes: Vec<[jostle_math::Vec3; 2]>,
     inertia: Vec<Mat3>,
-    /// The f64 inverse of each body's `inertia`, for its turns (`gyroscopic::inverse_of`).
-    inertia_inverse: Vec<Option<crate::energy::Inverse64>>,
+    /// The f64 inverse of each body's `inertia` (`None` for a zero one), taken once a step for
+    /// its turns (`gyroscopic::turn_inverted`).
+    inertia_inverse: Vec<Option<Inverse64>>,
     /// With the gyroscopic term: each body's step-start world inverse inertia if some contact
     /// of the step involves it, else zero (`gyroscopic::turn_against`).
     rows_inverse: Vec<Mat3>,
@@ -369,11 +371,11 @@ impl SoftStepResolver {
             }
         }
         self.inertia_inverse.clear();
-        self.inertia_inverse.extend(self.inertia.iter().map(|&i| {
-            (i != Mat3::ZERO)
-                .then(|| gyroscopic::inverse_of(i))
-                .flatten()
-        }));
+        self.inertia_inverse.extend(
+            self.inertia
+                .iter()
+                .map(|&i| (i != Mat3::ZERO).then(|| Inverse64::of(i)).flatten()),
+        );
     }
 
     /// Marks [`body_state::FREE`] the bodies in no batch, not turning and without forces:
@@ -940,7 +942,7 @@ struct Substeps<'a> {
     pushes: &'a [[Vec3; 2]],
     inertia: &'a [Mat3],
     /// [`SoftStepResolver::inertia_inverse`].
-    inertia_inverse: &'a [Option<crate::energy::Inverse64>],
+    inertia_inverse: &'a [Option<Inverse64>],
     /// [`SoftStepResolver::rows_inverse`].
     rows_inverse: &'a [Mat3],
     gyroscopic: bool,

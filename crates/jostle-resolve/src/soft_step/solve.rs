@@ -1163,17 +1163,15 @@ fn biased_row<F: Lane, L: LinearResponse<F>>(
     let extra = (-s * p.preload_slope).max(F::ZERO);
     let extra = F::select(extra.cmpgt(p.preload), p.preload, extra);
     let spring = F::select(speculative, s, s - extra);
+    // The whole bias is capped at the push-out speed (scaled with gravity beyond Earth's,
+    // `BiasedPass::max_push_out`): a cap on only the push beyond the load let a box crushed
+    // between two closing kinematic walls ratchet its springs' load up step after step, and it
+    // left at 31 m/s (benches/RESULTS.md, "A crushed box thrown out, and rods spun up").
+    let bias = soft_mass * (p.bias_rate * spring).max(c.push_out);
     let resting = p.normal_impulse.cmpgt(F::ZERO) & c.resting_speed.cmplt(p.relative_velocity);
     let allowance = F::select(resting, p.bias_rate * c.slop + c.gravity_speed, F::ZERO);
-    // The whole bias is capped at the push-out speed (which the resolver scales with
-    // gravity beyond Earth's, `BiasedPass::max_push_out`): a cap on only the push beyond the
-    // load let a box crushed between two closing kinematic walls ratchet its springs' load
-    // up step after step, and it left at 31 m/s (benches/RESULTS.md, "A crushed box thrown
-    // out").
-    let bias = soft_mass * (p.bias_rate * spring).max(c.push_out);
-    let load = -bleed - soft_mass * allowance;
     let vn = pair.relative_velocity(p).dot(p.normal);
-    let carried = bias.max(load);
+    let carried = bias.max(-bleed - soft_mass * allowance);
     let excess = F::select(speculative, F::ZERO, bias - carried);
 
     let rigid = -p.normal_mass * (vn + s * c.inv_h);
@@ -1197,19 +1195,19 @@ fn biased_row<F: Lane, L: LinearResponse<F>>(
 /// The biased pass over one batch, with split impulses for overlap beyond what the load
 /// explains.
 ///
-/// The soft constraint's impulse is Δλ = −m·s_m·v_n − b − s_i·λ, with b = m·s_m·β·s the bias (s <
-/// 0 on overlap, b clamped to the push-out speed) and s_i·λ
-/// the bleed that makes it a spring. Under a steady load λ the spring settles where the two
-/// balance, b = −s_i·λ (s_i·λ is exactly the bias of the spring's static compression λ/(h·k)):
-/// that much bias is the spring carrying its load and stays in the real impulse, as in the plain
-/// soft step. On a resting contact (one that carries a load, λ > 0, and approached slower than
+/// The soft constraint's impulse is Δλ = −m·s_m·v_n − b − s_i·λ, with b = m·s_m·β·s the bias
+/// (s < 0 on overlap, b clamped to the push-out speed) and s_i·λ the bleed that makes it a
+/// spring. Under a steady load λ the spring settles where the two balance, b = −s_i·λ (s_i·λ
+/// is exactly the bias of the spring's static compression λ/(h·k)): that much bias is the
+/// spring carrying its load and stays in the real impulse, as in the plain soft step. On a
+/// resting contact (one that carries a load, λ > 0, and approached slower than
 /// `resting_speed` at the start of the step) so does an allowance of m·s_m·(β·`slop` + |g|·h):
 /// the discrete equilibrium sits one substep of gravity's speed deeper (|g|·h/β: 1.1 mm between
 /// bodies at the defaults, 4.5 mm at 4 substeps and 30 Hz, where the figures that follow were
 /// measured), and a loaded spring must keep reacting to changes of its load through real
 /// velocity. With every bias beyond the static compression in pseudo velocities the 20-row
-/// pyramid drifts 34 mm in 10 s instead of 1 mm; with the slop alone (5 mm) and no gravity term
-/// the 1:100 pair drifts 18 mm instead of 0.5 mm.
+/// pyramid drifts 34 mm in 10 s instead of 1 mm; with the slop alone (5 mm) and no gravity
+/// term the 1:100 pair drifts 18 mm instead of 0.5 mm.
 ///
 /// Any overlap deeper than that, and all overlap of a contact that carries no load or hit
 /// fast (bodies that start overlapping, an impact), would be pushed out by the excess bias as
