@@ -971,6 +971,7 @@ impl Substeps<'_> {
             // the poses the biased pass starts from.
             let pass = solve::BiasedPass {
                 stored_separation: substep > 0 && self.relax_iterations > 0 && !self.pass.rigid,
+                after_warm_start: substep == 0,
                 ..self.pass
             };
             timing.time(Timing::INTEGRATE, || {
@@ -1249,6 +1250,7 @@ impl Resolver for SoftStepResolver {
             sweeps: normal_sweeps,
             rate: self.settings.push_out_rate * inv_h,
             stored_separation: false,
+            after_warm_start: false,
         };
         let substeps_start = Stopwatch::start();
         let direct_live = !self.direct.is_empty();

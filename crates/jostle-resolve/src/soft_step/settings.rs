@@ -93,7 +93,10 @@ pub struct SoftStepSettings {
     /// drags resting bodies sideways (a 20-row pyramid drifts 5.3 mm from 2 s to 10 s with
     /// friction in both passes, 1.1 mm without; rapier3d's `friction_in_bias_pass` default
     /// is the same). Friction is always solved in the biased pass when `relax_iterations` is
-    /// 0, since there is no other.
+    /// 0, since there is no other. Without it, the first substep's biased pass still keeps each
+    /// point's friction impulse, carried from the last step, within μ times the normal impulse
+    /// the pass leaves: a warm start whose normal impulse the pass takes back (a box crushed
+    /// between walls, one of which passed through it) must not keep its friction.
     pub friction_in_bias_pass: bool,
     /// Start each step from the contact impulses of the previous step (matched by feature
     /// id). Default true. Without it stacks need many more substeps to stand.
