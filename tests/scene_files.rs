@@ -53,6 +53,32 @@ fn defaults_are_the_documented_ones() {
     assert!((body.mass() - 523.598_8).abs() < 0.05, "{}", body.mass());
 }
 
+/// A compound's parts take the compound's origin and orientation when they give none, as a
+/// collider does (both fields were required).
+#[test]
+fn compound_parts_default_to_the_compound_frame() {
+    let scene = Scene::parse(
+        "Scene(bodies: [Body(name: \"dumbbell\", shape: Compound(parts: [\
+           CompoundPart(shape: Ball(radius: 0.5)),\
+           CompoundPart(shape: Ball(radius: 0.5), position: (0.0, 2.0, 0.0))]))])",
+        "t.ron",
+    )
+    .unwrap();
+    let world = scene.build().unwrap();
+    let (_, _, body) = world.bodies().next().unwrap();
+    // Two 0.5 m balls of 523.6 kg, at 0 and 2 m: the centre of mass half-way.
+    assert!(
+        (body.mass() - 2.0 * 523.598_8).abs() < 0.1,
+        "{}",
+        body.mass()
+    );
+    assert!(
+        (body.position.y - 1.0).abs() < 1e-4,
+        "centre of mass at {}",
+        body.position
+    );
+}
+
 fn error(text: &str) -> SceneError {
     match Scene::parse(text, "bad.ron") {
         Ok(_) => panic!("accepted a bad scene: {text}"),

@@ -157,6 +157,19 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         }
     }
 
+    // Two files whose scenes have the same name would share one plot and be told apart nowhere
+    // in results.csv or the table: each is then named with its file as well.
+    let shared: Vec<String> = cases
+        .iter()
+        .filter(|c| cases.iter().any(|o| o.scene == c.scene && o.path != c.path))
+        .map(|c| c.scene.clone())
+        .collect();
+    for case in &mut cases {
+        if shared.contains(&case.scene) {
+            case.scene = format!("{} ({})", case.scene, case.path.display());
+        }
+    }
+
     let bar = ProgressBar::new(cases.len() as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {elapsed} {msg}")

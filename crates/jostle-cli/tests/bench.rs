@@ -149,3 +149,57 @@ fn bench_writes_csv_with_finite_metrics_and_both_plots() {
     let png = image::open(out_dir.join("tiny_rest.png")).unwrap();
     assert_eq!((png.width(), png.height()), (800, 560));
 }
+
+/// Two files whose scenes share a name get a plot each and rows told apart by file: before,
+/// both files' rows went into one plot under one name, and results.csv could not say which
+/// row came from which file.
+#[test]
+fn scenes_of_the_same_name_from_two_files_are_kept_apart() {
+    let dir = temp_dir().join("same-name");
+    let (a, b) = (dir.join("a"), dir.join("b"));
+    for (d, height) in [(&a, 1.0), (&b, 5.0)] {
+        std::fs::create_dir_all(d).unwrap();
+        std::fs::write(
+            d.join("drop.ron"),
+            format!(
+                "Scene(name: \"drop\", steps: 30, bodies: [\
+                   Body(name: \"ground\", shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true),\
+                   Body(name: \"ball\", shape: Ball(radius: 0.5), position: (0.0, {height}, 0.0))])"
+            ),
+        )
+        .unwrap();
+    }
+    let out_dir = dir.join("out");
+    let out = Command::new(env!("CARGO_BIN_EXE_jostle"))
+        .arg("bench")
+        .arg(a.join("drop.ron"))
+        .arg(b.join("drop.ron"))
+        .args(["--resolver", "soft-step", "--out"])
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
+    let scenes: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').next())
+        .collect();
+    assert_eq!(scenes.len(), 2, "{csv}");
+    assert!(
+        scenes[0] != scenes[1] && scenes.iter().all(|s| s.contains("drop.ron")),
+        "{csv}"
+    );
+    let pngs = std::fs::read_dir(&out_dir)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .is_ok_and(|e| e.path().extension().is_some_and(|x| x == "png"))
+        })
+        .count();
+    assert_eq!(pngs, 2, "one plot per file");
+}

@@ -81,10 +81,20 @@ pub struct CompoundPart {
     /// The part's shape: a ball, cuboid, capsule, cylinder or convex hull (no half-space,
     /// mesh or nested compound).
     pub shape: ShapeDesc,
-    /// Position of the part's origin in the compound's frame (m).
+    /// Position of the part's origin in the compound's frame (m). Default (in scene files):
+    /// the compound's origin.
+    #[cfg_attr(feature = "serde", serde(default))]
     pub position: Vec3,
-    /// Orientation of the part in the compound's frame (normalized on build).
+    /// Orientation of the part in the compound's frame (normalized on build). Default (in
+    /// scene files): the compound's own, the identity.
+    #[cfg_attr(feature = "serde", serde(default = "identity_rotation"))]
     pub rotation: Quat,
+}
+
+/// The default rotation of a [`CompoundPart`] read from a file.
+#[cfg(feature = "serde")]
+fn identity_rotation() -> Quat {
+    Quat::IDENTITY
 }
 
 /// A collision shape, described by plain numbers (SI units, shape's own frame).
