@@ -213,6 +213,9 @@ impl World {
         body.angular_damping = desc.angular_damping;
         body.sleep.can_sleep = desc.can_sleep;
         body.sleep.motion = 2.0 * self.settings.sleep.threshold;
+        // A body given a velocity has been moving so (the sleep test's mean velocities).
+        body.sleep.mean_linear = body.linear_velocity;
+        body.sleep.mean_angular = body.angular_velocity;
         body.ccd = desc.ccd;
         body.name = desc.name;
         if let Some(kinematic) = desc.kinematic {
@@ -632,6 +635,8 @@ impl World {
         if !body.is_rotation_locked() {
             body.angular_velocity = body.without_locked_turn(angular);
         }
+        body.sleep.mean_linear = body.linear_velocity;
+        body.sleep.mean_angular = body.angular_velocity;
         Ok(())
     }
 

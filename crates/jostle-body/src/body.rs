@@ -25,6 +25,13 @@ pub struct SleepState {
     pub can_sleep: bool,
     /// Recency-weighted average of |v|² + |ω|² (m²/s², rad²/s² treated alike).
     pub motion: f32,
+    /// Recency-weighted average of the linear velocity (m/s), with the same bias as
+    /// `motion`: a body moving steadily keeps it, one jittering in place averages it away.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub mean_linear: Vec3,
+    /// Recency-weighted average of the angular velocity (rad/s), as `mean_linear`.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub mean_angular: Vec3,
 }
 
 impl Default for SleepState {
@@ -33,6 +40,8 @@ impl Default for SleepState {
             awake: true,
             can_sleep: true,
             motion: f32::MAX,
+            mean_linear: Vec3::ZERO,
+            mean_angular: Vec3::ZERO,
         }
     }
 }
@@ -625,6 +634,14 @@ impl RigidBody {
         non_negative("linear_damping", self.linear_damping)?;
         non_negative("angular_damping", self.angular_damping)?;
         non_negative("sleep.motion", self.sleep.motion)?;
+        for (field, v) in [
+            ("sleep.mean_linear", self.sleep.mean_linear),
+            ("sleep.mean_angular", self.sleep.mean_angular),
+        ] {
+            if !v.is_finite() {
+                return Err((field, format!("must be finite, got {v}")));
+            }
+        }
         if !self.gravity_scale.is_finite() {
             return Err((
                 "gravity_scale",

@@ -19,6 +19,17 @@ pub struct SleepSettings {
     /// motion ← bias·motion + (1 − bias)·(|v|² + |ω|²). Default 0.5 (motion halves its weight
     /// every second of simulated time), as in Cyclone.
     pub bias_base: f32,
+    /// Threshold (m²/s²) on the mean motion |v̄|² + r²·|ω̄|², v̄ and ω̄ the velocities averaged
+    /// with the same recency bias and r the body's radius of gyration (the mean turn as the
+    /// speed it gives the body's mass), and on the present |v|²: a body
+    /// qualifies for sleep only when both are below it as well. Default 0.0025 (0.05 m/s).
+    /// The motion average alone let a body moving steadily below √ε (0.55 m/s) fall asleep
+    /// and stop: a ball gliding at 0.3 m/s in zero gravity, a box sliding down a slope steeper
+    /// than its friction angle, a box on a moving belt. A body at rest jitters about its
+    /// place, slowly, and its velocities average away. A body speeding up from rest at less
+    /// than about 0.05 m/s² still qualifies once its motion has decayed (1 s after it was
+    /// added or woken) and is stopped.
+    pub drift_threshold: f32,
 }
 
 impl SleepSettings {
@@ -29,6 +40,12 @@ impl SleepSettings {
             return Err((
                 "threshold",
                 format!("must be finite and > 0, got {}", self.threshold),
+            ));
+        }
+        if !(self.drift_threshold.is_finite() && self.drift_threshold > 0.0) {
+            return Err((
+                "drift_threshold",
+                format!("must be finite and > 0, got {}", self.drift_threshold),
             ));
         }
         if !(self.bias_base.is_finite() && self.bias_base > 0.0 && self.bias_base < 1.0) {
@@ -47,6 +64,7 @@ impl Default for SleepSettings {
             enabled: true,
             threshold: 0.3,
             bias_base: 0.5,
+            drift_threshold: 0.0025,
         }
     }
 }
