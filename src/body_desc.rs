@@ -152,6 +152,7 @@ pub struct BodyDesc {
 /// properties are those of a dynamic body of its shape and `mass`, kept for when it is made
 /// dynamic ([`crate::World::set_body_type`]).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Kinematic {
     /// Moved by its velocity (`linear_velocity`, `angular_velocity`) until told otherwise
     /// ([`crate::World::set_velocity`]).

@@ -243,6 +243,31 @@ fn every_asset_loads_and_builds() {
     assert!(n >= 2);
 }
 
+/// A misspelt field of a kinematic motion is refused like any other (it was ignored: `Turn(...,
+/// x: 1)` ran).
+#[test]
+fn unknown_fields_inside_a_kinematic_motion_are_errors() {
+    for (motion, field) in [
+        (
+            "Turn(center: (0.0, 0.0, 0.0), axis: (0.0, 1.0, 0.0), period: 4.0, x: 1)",
+            "`x` in `Turn`",
+        ),
+        (
+            "Line(offset: (1.0, 0.0, 0.0), period: 4.0, perod: 2.0)",
+            "`perod` in `Line`",
+        ),
+    ] {
+        let text = format!(
+            "Scene(bodies: [Body(name: \"k\", shape: Ball(radius: 0.5), kinematic: {motion})])"
+        );
+        let e = error(&text).to_string();
+        assert!(
+            e.contains(field) && e.contains("body \"k\""),
+            "{motion}: {e}"
+        );
+    }
+}
+
 #[test]
 fn unknown_fields_inside_a_shape_are_errors() {
     let e = error("Scene(bodies: [Body(name: \"s\", shape: Ball(radius: 1.0, colour: 2))])");

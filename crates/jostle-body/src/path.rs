@@ -23,7 +23,11 @@ use std::f64::consts::TAU;
 /// assert!((at_half - Vec3::new(4.0, 0.0, 0.0)).length() < 1e-5);
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub enum KinematicPath {
     /// Back and forth along a segment, smoothly: at time t the body is at
     /// start + offset·(1 − cos(2πt/period))/2, with its orientation kept.
