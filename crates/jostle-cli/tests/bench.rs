@@ -9,6 +9,21 @@ fn temp_dir() -> PathBuf {
     dir
 }
 
+/// Runs `jostle bench` with `args`; it must succeed.
+fn bench(args: &[&std::ffi::OsStr]) -> std::process::Output {
+    let out = Command::new(env!("CARGO_BIN_EXE_jostle"))
+        .arg("bench")
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 const HEADER: [&str; 14] = [
     "scene",
     "resolver",
@@ -55,20 +70,17 @@ fn bench_writes_csv_with_finite_metrics_and_both_plots() {
     )
     .unwrap();
     let out_dir = dir.join("out");
-    let out = Command::new(env!("CARGO_BIN_EXE_jostle"))
-        .arg("bench")
-        .arg(&rest)
-        .arg(&spin)
-        .arg(&fall)
-        .args(["--sweep", "substeps", "--settle", "0.5", "--out"])
-        .arg(&out_dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = bench(&[
+        rest.as_os_str(),
+        spin.as_os_str(),
+        fall.as_os_str(),
+        "--sweep".as_ref(),
+        "substeps".as_ref(),
+        "--settle".as_ref(),
+        "0.5".as_ref(),
+        "--out".as_ref(),
+        out_dir.as_os_str(),
+    ]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         stdout.contains("tiny rest") && stdout.contains("soft-step"),
@@ -170,19 +182,15 @@ fn scenes_of_the_same_name_from_two_files_are_kept_apart() {
         .unwrap();
     }
     let out_dir = dir.join("out");
-    let out = Command::new(env!("CARGO_BIN_EXE_jostle"))
-        .arg("bench")
-        .arg(a.join("drop.ron"))
-        .arg(b.join("drop.ron"))
-        .args(["--resolver", "soft-step", "--out"])
-        .arg(&out_dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let (first, second) = (a.join("drop.ron"), b.join("drop.ron"));
+    bench(&[
+        first.as_os_str(),
+        second.as_os_str(),
+        "--resolver".as_ref(),
+        "soft-step".as_ref(),
+        "--out".as_ref(),
+        out_dir.as_os_str(),
+    ]);
     let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
     let scenes: Vec<&str> = csv
         .lines()

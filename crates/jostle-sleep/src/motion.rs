@@ -1,4 +1,5 @@
-//! The per-body motion average of the seed lecture and Cyclone's `RigidBody::integrate`.
+//! The per-body motion average of the seed lecture and Cyclone's `RigidBody::integrate`, and
+//! the mean velocities that keep a body moving steadily awake.
 
 use crate::SleepSettings;
 use jostle_body::RigidBody;
@@ -7,13 +8,12 @@ use jostle_body::RigidBody;
 /// for sleep: motion ← bias·motion + (1 − bias)·max(|v|² + |ω|², moved) with bias = base^dt,
 /// capped at 10·ε, and the mean velocities v̄ ← bias·v̄ + (1 − bias)·v (ω̄ the same);
 /// qualifies when motion < ε, both |v̄|² + r²·|ω̄|² (r the radius of gyration) and |v|² are
-/// below `drift_threshold`, and the
-/// body may sleep (a body moving or spinning steadily has a mean velocity, one speeding up from
-/// rest a velocity ahead of its mean; one at rest jitters or rocks about its place, slowly,
-/// and its mean is none). `moved` is the square of
-/// how fast the step changed the body's pose, (|Δx|² + Δθ²)/dt² (the world uses
-/// (2·sin(Δθ/2))² for Δθ²): a body that a resolver
-/// pushes out of overlap without giving it velocity (split impulses, projection) is moving,
+/// below `drift_threshold`, and the body may sleep (a body moving or spinning steadily has a
+/// mean velocity, one speeding up from rest a velocity ahead of its mean; one at rest jitters
+/// or rocks about its place, slowly, and its mean is none). `moved` is the square of how fast
+/// the step changed the body's pose, (|Δx|² + Δθ²)/dt² (the world uses (2·sin(Δθ/2))² for
+/// Δθ²): a body that a resolver pushes out of overlap without giving it velocity (split
+/// impulses, projection) is moving,
 /// and must not fall asleep still overlapping.
 pub fn update_motion(body: &mut RigidBody, settings: &SleepSettings, dt: f32, moved: f32) -> bool {
     let speed = body.linear_velocity.length_squared() + body.angular_velocity.length_squared();

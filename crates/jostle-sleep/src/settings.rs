@@ -21,8 +21,8 @@ pub struct SleepSettings {
     pub bias_base: f32,
     /// Threshold (m²/s²) on the mean motion |v̄|² + r²·|ω̄|², v̄ and ω̄ the velocities averaged
     /// with the same recency bias and r the body's radius of gyration (the mean turn as the
-    /// speed it gives the body's mass), and on the present |v|²: a body
-    /// qualifies for sleep only when both are below it as well. Default 0.0025 (0.05 m/s).
+    /// speed it gives the body's mass), and on the present |v|²: a body qualifies for sleep
+    /// only when both are below it as well. Default 0.0025 (0.05 m/s).
     /// The motion average alone let a body moving steadily below √ε (0.55 m/s) fall asleep
     /// and stop: a ball gliding at 0.3 m/s in zero gravity, a box sliding down a slope steeper
     /// than its friction angle, a box on a moving belt. A body at rest jitters about its
