@@ -634,14 +634,8 @@ impl RigidBody {
         non_negative("linear_damping", self.linear_damping)?;
         non_negative("angular_damping", self.angular_damping)?;
         non_negative("sleep.motion", self.sleep.motion)?;
-        for (field, v) in [
-            ("sleep.mean_linear", self.sleep.mean_linear),
-            ("sleep.mean_angular", self.sleep.mean_angular),
-        ] {
-            if !v.is_finite() {
-                return Err((field, format!("must be finite, got {v}")));
-            }
-        }
+        vector("sleep.mean_linear", self.sleep.mean_linear)?;
+        vector("sleep.mean_angular", self.sleep.mean_angular)?;
         if !self.gravity_scale.is_finite() {
             return Err((
                 "gravity_scale",
