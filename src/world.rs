@@ -212,10 +212,7 @@ impl World {
         body.linear_damping = desc.linear_damping;
         body.angular_damping = desc.angular_damping;
         body.sleep.can_sleep = desc.can_sleep;
-        body.sleep.motion = 2.0 * self.settings.sleep.threshold;
-        // A body given a velocity has been moving so (the sleep test's mean velocities).
-        body.sleep.mean_linear = body.linear_velocity;
-        body.sleep.mean_angular = body.angular_velocity;
+        jostle_sleep::motion::restart(&mut body, &self.settings.sleep);
         body.ccd = desc.ccd;
         body.name = desc.name;
         if let Some(kinematic) = desc.kinematic {
@@ -944,7 +941,7 @@ impl World {
         body.set_body_type(body_type)
             .map_err(|e| invalid(("body_type", e.to_string())))?;
         if body_type == BodyType::Dynamic {
-            body.sleep.motion = 2.0 * self.settings.sleep.threshold;
+            jostle_sleep::motion::restart(body, &self.settings.sleep);
         }
         body.sleep.awake = match body_type {
             BodyType::Fixed => false,

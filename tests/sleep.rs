@@ -5,7 +5,7 @@
 mod common;
 use common::*;
 use jostle::scene::Scene;
-use jostle::{BodyDesc, ResolverChoice, ShapeDesc, Vec3};
+use jostle::{BodyDesc, ResolverChoice, RigidBody, ShapeDesc, Vec3};
 
 const DT: f32 = 1.0 / 60.0;
 
@@ -307,9 +307,8 @@ fn a_world_at_rest_steps_as_a_full_step_would_and_wakes_on_any_change() {
     );
 }
 
-/// The position of body `name` after `seconds` of the scene `text` at the defaults (sleep on),
-/// with `resolver`, and whether it is awake then.
-fn after(text: &str, resolver: &ResolverChoice, name: &str, seconds: f32) -> (Vec3, bool) {
+/// Body `name` after `seconds` of the scene `text` at the defaults (sleep on), with `resolver`.
+fn after(text: &str, resolver: &ResolverChoice, name: &str, seconds: f32) -> RigidBody {
     let scene = Scene::parse(text, "t.ron").unwrap();
     let mut settings = scene.settings();
     settings.resolver = resolver.clone();
@@ -318,8 +317,7 @@ fn after(text: &str, resolver: &ResolverChoice, name: &str, seconds: f32) -> (Ve
     for _ in 0..(seconds / DT).round() as u32 {
         w.step(DT).unwrap();
     }
-    let b = w.body(h).unwrap();
-    (b.position, b.is_awake())
+    w.body(h).unwrap().clone()
 }
 
 /// A body moving steadily is not put to sleep: the motion average alone (|v|² + |ω|² below
@@ -335,22 +333,16 @@ fn a_body_gliding_or_turning_steadily_is_not_put_to_sleep() {
                     angular_velocity: (0.0, {speed}, 0.0))])"
         );
         for r in resolvers() {
-            let (at, awake) = after(&text, &r, "ball", 5.0);
+            let ball = after(&text, &r, "ball", 5.0);
             let expected = 5.0 * speed;
             assert!(
-                awake && (at.x - expected).abs() < 1e-3 * expected,
-                "{}: ball at {speed} m/s: at {at} after 5 s, awake {awake}",
-                r.name()
+                ball.is_awake() && (ball.position.x - expected).abs() < 1e-3 * expected,
+                "{}: ball at {speed} m/s: at {} after 5 s, awake {}",
+                r.name(),
+                ball.position,
+                ball.is_awake()
             );
-            let scene = Scene::parse(&text, "t.ron").unwrap();
-            let mut settings = scene.settings();
-            settings.resolver = r.clone();
-            let mut w = scene.build_with(settings).unwrap();
-            let h = w.find_body("box").unwrap();
-            for _ in 0..300 {
-                w.step(DT).unwrap();
-            }
-            let b = w.body(h).unwrap();
+            let b = after(&text, &r, "box", 5.0);
             assert!(
                 b.is_awake() && (b.angular_velocity.y - speed).abs() < 1e-3 * speed,
                 "{}: box turning at {speed} rad/s: {} after 5 s",
@@ -386,8 +378,11 @@ fn a_box_on_a_slope_steeper_than_its_friction_angle_slides_and_does_not_sleep() 
             );
             let expected = 0.5 * 9.81 * (s - 0.5 * c) * 25.0;
             for r in resolvers() {
-                let (at, awake) = after(&text, &r, "box", 5.0);
-                let slid = (at - Vec3::new(-s * half, c * half, 0.0)).length();
+                let b = after(&text, &r, "box", 5.0);
+                let (slid, awake) = (
+                    (b.position - Vec3::new(-s * half, c * half, 0.0)).length(),
+                    b.is_awake(),
+                );
                 let case = format!(
                     "{}: {degrees}°, {} m box: slid {slid} m in 5 s (Coulomb: {expected}), awake {awake}",
                     r.name(),

@@ -48,16 +48,21 @@ fn gyration_squared(body: &RigidBody) -> f32 {
         .unwrap_or(0.0)
 }
 
-/// Wakes `body`: awake, with motion at 2·ε so it cannot fall straight back asleep, and its
-/// mean velocities at its velocities (zero for a body that slept; a body woken with a
-/// velocity has been moving so).
+/// Wakes `body`: awake, and its averages restarted ([`restart`]).
 pub fn wake(body: &mut RigidBody, settings: &SleepSettings) {
     if !body.is_fixed() {
         body.sleep.awake = true;
-        body.sleep.motion = 2.0 * settings.threshold;
-        body.sleep.mean_linear = body.linear_velocity;
-        body.sleep.mean_angular = body.angular_velocity;
+        restart(body, settings);
     }
+}
+
+/// Restarts `body`'s averages, as for a body just added, woken or made dynamic: motion at 2·ε
+/// so it cannot fall straight back asleep, and the mean velocities at its velocities (zero for
+/// a body that slept; a body given a velocity has been moving so).
+pub fn restart(body: &mut RigidBody, settings: &SleepSettings) {
+    body.sleep.motion = 2.0 * settings.threshold;
+    body.sleep.mean_linear = body.linear_velocity;
+    body.sleep.mean_angular = body.angular_velocity;
 }
 
 /// Puts `body` to sleep: not awake, zero velocities (and mean velocities).
