@@ -347,7 +347,8 @@ fn load_compensation_removes_the_load_proportional_sink() {
 /// sets the simulated time (default 20; the long runs use 60); `FAMILY_SET=heavy` runs the
 /// sweep of heavy boxes on light ones (`family::heavy_sweep`) instead of the family,
 /// `FAMILY_SET=heavy_seeds` the same from many more seeds (`family::heavy_seeds`),
-/// `FAMILY_SET=tall` the tall members' variations (`family::tall_variations`).
+/// `FAMILY_SET=tall` the tall members' variations (`family::tall_variations`),
+/// `FAMILY_SET=small` the members of 5 mm to 5 cm boxes (`family::small`).
 #[test]
 #[ignore = "a measurement of several minutes in release; run with --ignored --nocapture"]
 fn family_table() {
@@ -373,6 +374,7 @@ fn family_table() {
         Ok("heavy_seeds") => family::heavy_seeds(),
         Ok("tall") => family::tall_variations(),
         Ok("large") => family::large_perturbed(),
+        Ok("small") => family::small(),
         Ok("unseen") => family::unseen_from_env(),
         _ => family::base()
             .into_iter()

@@ -6,7 +6,8 @@
 //!
 //! Each pair keeps its parry manifolds and workspace from step to step, so parry's coherence
 //! (and its feature ids) carries over; each manifold is reduced to at most four points
-//! ([`crate::reduce`]); each point carries the resolver's accumulated impulse, matched by
+//! ([`crate::reduce`]; boxes and cylinders smaller than 5 cm are clipped scaled up, see
+//! `clip_scale`); each point carries the resolver's accumulated impulse, matched by
 //! (sub-shapes, feature ids) when the manifold is recomputed. A pair whose relative pose moved
 //! less than the reuse tolerances since its manifold was computed is not recomputed: only its
 //! separations are refreshed, and its world points are rebuilt from the local points, so they
@@ -27,7 +28,7 @@ use parry3d::math::Pose;
 use parry3d::query::{
     ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
 };
-use parry3d::shape::PackedFeatureId;
+use parry3d::shape::{Cuboid, Cylinder, PackedFeatureId, Shape};
 use std::borrow::Cow;
 
 /// One contact point between two bodies, ready for the resolver.
@@ -1685,14 +1686,34 @@ fn compute(
             .iter()
             .map(move |p| ((m.subshape1, m.subshape2, p.fid1, p.fid2), p.data))
     }));
-    let result = DefaultQueryDispatcher.contact_manifolds(
-        pos12,
-        &*c1.shape.0,
-        &*c2.shape.0,
-        prediction,
-        &mut state.manifolds,
-        &mut state.workspace,
-    );
+    let clip = match (ClipShape::of(&*c1.shape.0), ClipShape::of(&*c2.shape.0)) {
+        (Some(s1), Some(s2)) => Some((s1, s2, clip_scale(s1.size().min(s2.size())))),
+        _ => None,
+    };
+    let result = match clip {
+        // Small boxes and cylinders are clipped scaled up, their points scaled back.
+        Some((s1, s2, scale)) if scale != 1.0 => {
+            scale_points(&mut state.manifolds, scale);
+            let result = DefaultQueryDispatcher.contact_manifolds(
+                &Pose::from_parts(pos12.translation * scale, pos12.rotation),
+                s1.scaled(scale).shape(),
+                s2.scaled(scale).shape(),
+                prediction * scale,
+                &mut state.manifolds,
+                &mut state.workspace,
+            );
+            scale_points(&mut state.manifolds, scale.recip());
+            result
+        }
+        _ => DefaultQueryDispatcher.contact_manifolds(
+            pos12,
+            &*c1.shape.0,
+            &*c2.shape.0,
+            prediction,
+            &mut state.manifolds,
+            &mut state.workspace,
+        ),
+    };
     if result.is_err() {
         // An unsupported pair (two half-spaces): no contact, by definition of the shapes.
         state.manifolds.clear();
@@ -1723,6 +1744,95 @@ fn compute(
     } else {
         None
     };
+}
+
+/// The size (largest half dimension, m) at or above which a pair of boxes or cylinders is
+/// clipped at its own size ([`clip_scale`]).
+const CLIP_SIZE: f32 = 0.05;
+
+/// The factor by which a pair of boxes or cylinders is scaled for parry's clipping of their
+/// faces, from the smaller of their sizes ([`ClipShape::size`]): 1 at [`CLIP_SIZE`] or
+/// above, else the least power of four that brings it there. A power of four scales every
+/// operation exactly in f32 (square roots included), so the scaled result is the exact scaling
+/// of one at the shapes' own size but for parry's absolute tolerances.
+///
+/// Those tolerances are why: parry's 2D edge intersection takes two edges as parallel when
+/// |d₁|²·|d₂|²·sin²θ falls below f32's epsilon, so edges shorter than about 1.9 cm never
+/// cross, and its test of a corner inside the other face loses corners on shared edges. Two
+/// equal boxes of 1 cm stacked a little apart then touched at two diagonal corners only,
+/// about which the upper one turned freely and toppled (and parry's coherence kept that
+/// manifold until a point moved 1 mm); two coins of 1 cm radius fell over. At 5 cm (edges of
+/// 0.1 m, the smallest boxes of the stability family) edges within about 2° count as
+/// parallel: for clipping that is wanted, since where two nearly parallel edges cross moves
+/// along them by their offset over their angle. Scaled further, to 0.5 m, such crossings
+/// jumped along the edges of swaying boxes, and a column of ten 2 cm cubes fell.
+fn clip_scale(size: f32) -> f32 {
+    let mut scale = 1.0;
+    // At most 4²⁰ (10¹²), so that the scaled extents of a degenerate shape stay finite.
+    for _ in 0..20 {
+        if size * scale >= CLIP_SIZE {
+            break;
+        }
+        scale *= 4.0;
+    }
+    scale
+}
+
+/// A shape whose contacts parry finds by clipping polygonal faces (a box, or a cylinder,
+/// whose caps it clips as squares), copied so that it can be scaled ([`clip_scale`]).
+#[derive(Clone, Copy)]
+enum ClipShape {
+    Cuboid(Cuboid),
+    Cylinder(Cylinder),
+}
+
+impl ClipShape {
+    fn of(shape: &dyn Shape) -> Option<Self> {
+        shape
+            .as_cuboid()
+            .map(|c| Self::Cuboid(*c))
+            .or_else(|| shape.as_cylinder().map(|c| Self::Cylinder(*c)))
+    }
+
+    /// The largest half dimension (m): the largest half extent of a box, the larger of a
+    /// cylinder's half height and radius. The largest, not the smallest: a coin's caps are
+    /// clipped by edges of its radius's length, whatever its thickness.
+    fn size(&self) -> f32 {
+        match self {
+            Self::Cuboid(c) => c.half_extents.max_element(),
+            Self::Cylinder(c) => c.half_height.max(c.radius),
+        }
+    }
+
+    fn scaled(self, scale: f32) -> Self {
+        match self {
+            Self::Cuboid(c) => Self::Cuboid(Cuboid::new(c.half_extents * scale)),
+            Self::Cylinder(c) => {
+                Self::Cylinder(Cylinder::new(c.half_height * scale, c.radius * scale))
+            }
+        }
+    }
+
+    fn shape(&self) -> &dyn Shape {
+        match self {
+            Self::Cuboid(c) => c,
+            Self::Cylinder(c) => c,
+        }
+    }
+}
+
+/// Scales every point of `manifolds` (both local points and the separation) by `scale`.
+fn scale_points(manifolds: &mut [Manifold], scale: f32) {
+    if scale == 1.0 {
+        return;
+    }
+    for m in manifolds {
+        for p in &mut m.points {
+            p.local_p1 *= scale;
+            p.local_p2 *= scale;
+            p.dist *= scale;
+        }
+    }
 }
 
 /// The gap (m) between two convex shapes along the unit direction `axis` of collider 1's

@@ -15,7 +15,8 @@
 //! boxes on light ones (`family::heavy_sweep`), `FAMILY=heavy_seeds` the same from many more
 //! seeds (`family::heavy_seeds`), `FAMILY=tall` the tall members' variations
 //! (`family::tall_variations`), `FAMILY=large` the members with 10 m boxes from perturbed
-//! starts (`family::large_perturbed`), `FAMILY=unseen` `FAMILY_UNSEEN` members (default 40) drawn at
+//! starts (`family::large_perturbed`), `FAMILY=small` the members of 5 mm to 5 cm boxes
+//! (`family::small`), `FAMILY=unseen` `FAMILY_UNSEEN` members (default 40) drawn at
 //! random from the seed `FAMILY_UNSEEN_SEED` (default 1; `family::unseen`); `FAMILY_ONLY` keeps the cases whose
 //! name contains one of its `|`-separated parts, or begins with a part written `^part`, as in
 //! `family_table`). With `--test` (`cargo
@@ -74,6 +75,8 @@ fn main() {
         cases.extend(family::tall_variations());
     } else if which == "large" {
         cases.extend(family::large_perturbed());
+    } else if which == "small" {
+        cases.extend(family::small());
     } else if which == "unseen" {
         cases.extend(family::unseen_from_env());
     } else {
