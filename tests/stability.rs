@@ -399,7 +399,8 @@ fn small_stack(shape: &str, half: f32, n: u32, gap: f32) -> (f32, f32) {
     (sideways, tilt)
 }
 
-/// Boxes and coins of 5 mm to 4 cm stand in stacks, from an exact start and from 0.1 mm gaps:
+/// Boxes (also as convex hulls and compounds) and coins of 5 mm to 4 cm stand in stacks, from
+/// an exact start and from 0.1 mm gaps:
 /// no body moves sideways by a fifth of its largest half size or ends tilted by 1°. Two equal
 /// boxes face to face used to touch at two diagonal corners only, below about 2 cm (parry's
 /// clipping of short edges, benches/RESULTS.md, "Small boxes and coins touch at their
@@ -409,6 +410,16 @@ fn small_stack(shape: &str, half: f32, n: u32, gap: f32) -> (f32, f32) {
 fn small_boxes_and_coins_stand_in_stacks() {
     let cube = |h: f32| format!("Cuboid(half_extents: ({h}, {h}, {h}))");
     let coin = |r: f32, h: f32| format!("Cylinder(half_height: {h}, radius: {r})");
+    let hull = |h: f32| {
+        let corners: Vec<String> = (0..8)
+            .map(|i| {
+                let sign = |bit: u32| if i & bit == 0 { -h } else { h };
+                format!("({}, {}, {})", sign(1), sign(2), sign(4))
+            })
+            .collect();
+        format!("ConvexHull(points: [{}])", corners.join(", "))
+    };
+    let compound = |h: f32| format!("Compound(parts: [CompoundPart(shape: {})])", cube(h));
     // (shape, half height, largest half size, count)
     let mut cases = Vec::new();
     for h in [0.0025, 0.005, 0.0075, 0.02] {
@@ -417,6 +428,11 @@ fn small_boxes_and_coins_stand_in_stacks() {
     for h in [0.005, 0.0075, 0.02] {
         cases.push((cube(h), h, h, 5));
     }
+    for h in [0.0025, 0.005, 0.02] {
+        cases.push((hull(h), h, h, 2));
+        cases.push((compound(h), h, h, 2));
+    }
+    cases.push((hull(0.0075), 0.0075, 0.0075, 5));
     for (r, h) in [(0.01, 0.001), (0.012, 0.0015), (0.02, 0.002)] {
         for n in [2, 5] {
             cases.push((coin(r, h), h, r, n));
@@ -426,7 +442,8 @@ fn small_boxes_and_coins_stand_in_stacks() {
     for (shape, half, size, n) in &cases {
         for gap in [0.0, 1e-4] {
             let (sideways, tilt) = small_stack(shape, *half, *n, gap);
-            let what = format!("{n} × {shape}, gaps of {gap} m");
+            let name = shape.split('(').next().unwrap_or_default();
+            let what = format!("{n} × {name} of half size {size} m, gaps of {gap} m");
             // The table of benches/RESULTS.md (`-- --nocapture`): sideways in half sizes, tilt in °.
             println!(
                 "| {what} | {:.3} | {:.2} |",

@@ -42,6 +42,9 @@ pub struct Collider {
     pub(crate) ccd: CcdShape,
     /// [`Collider::reach_radius`], computed whenever the shape or local pose is set.
     reach: f32,
+    /// The size that decides whether the narrow phase clips the shape scaled up
+    /// (`narrow_phase::clip_size`), computed whenever the shape is set.
+    pub(crate) clip_size: Option<f32>,
     /// The description the shape was built from ([`Collider::from_desc`]), for snapshots.
     desc: Option<ShapeDesc>,
     /// The display mesh, built on first use.
@@ -77,6 +80,7 @@ impl Collider {
                 extent: 0.0,
             },
             reach: 0.0,
+            clip_size: None,
             desc: None,
             display: OnceLock::new(),
         };
@@ -184,6 +188,7 @@ impl Collider {
             let sphere = self.shape.compute_bounding_sphere(&self.local_pose);
             sphere.center.length() + sphere.radius
         };
+        self.clip_size = crate::narrow_phase::clip_size(&*self.shape.0);
         self.display = OnceLock::new();
     }
 

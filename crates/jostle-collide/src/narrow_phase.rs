@@ -6,8 +6,8 @@
 //!
 //! Each pair keeps its parry manifolds and workspace from step to step, so parry's coherence
 //! (and its feature ids) carries over; each manifold is reduced to at most four points
-//! ([`crate::reduce`]; boxes and cylinders smaller than 5 cm are clipped scaled up, see
-//! `clip_scale`); each point carries the resolver's accumulated impulse, matched by
+//! ([`crate::reduce`]; boxes, cylinders, hulls and compounds smaller than 5 cm are clipped
+//! scaled up, see `clip_scale`); each point carries the resolver's accumulated impulse, matched by
 //! (sub-shapes, feature ids) when the manifold is recomputed. A pair whose relative pose moved
 //! less than the reuse tolerances since its manifold was computed is not recomputed: only its
 //! separations are refreshed, and its world points are rebuilt from the local points, so they
@@ -28,7 +28,7 @@ use parry3d::math::Pose;
 use parry3d::query::{
     ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
 };
-use parry3d::shape::{Cuboid, Cylinder, PackedFeatureId, Shape};
+use parry3d::shape::{Cuboid, Cylinder, PackedFeatureId, Shape, SharedShape};
 use std::borrow::Cow;
 
 /// One contact point between two bodies, ready for the resolver.
@@ -239,6 +239,20 @@ struct PairState {
     /// `None` while the pair has contacts, or none was found.
     #[cfg_attr(feature = "serde", serde(default))]
     apart: Option<Vec3>,
+    /// The pair's shapes scaled for clipping, when they are small and not both boxes or
+    /// cylinders ([`ScaledShapes`]); rebuilt after a restore.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    scaled: Option<Box<ScaledShapes>>,
+}
+
+/// Copies of a pair's shapes scaled by `scale` for clipping ([`clip_scale`]), kept while the
+/// pair lives: a convex hull or a compound is rebuilt to be scaled, once, not every query.
+#[derive(Clone)]
+struct ScaledShapes {
+    /// The shapes scaled ([`shape_id`]).
+    ids: (usize, usize),
+    scale: f32,
+    shapes: (SharedShape, SharedShape),
 }
 
 /// A pair's run of [`NarrowPhase::contacts`] at the last update: `count` contacts from
@@ -276,6 +290,7 @@ impl PairState {
             checked: None,
             emitted: None,
             apart: None,
+            scaled: None,
         }
     }
 
@@ -846,7 +861,7 @@ impl NarrowPhase {
 
     /// Writes the resolver's accumulated impulse for contact `index` of
     /// [`NarrowPhase::contacts`] back: the contact shows it, and its persistent point takes
-    /// it at the start of the next update, to warm start the contact found there ([`Emitted`]).
+    /// it at the start of the next update, to warm start the contact found there.
     /// An index past the contacts is a caller's bug: ignored in release builds, a failed debug
     /// assertion otherwise.
     #[inline]
@@ -1686,33 +1701,59 @@ fn compute(
             .iter()
             .map(move |p| ((m.subshape1, m.subshape2, p.fid1, p.fid2), p.data))
     }));
-    let clip = match (ClipShape::of(&*c1.shape.0), ClipShape::of(&*c2.shape.0)) {
-        (Some(s1), Some(s2)) => Some((s1, s2, clip_scale(s1.size().min(s2.size())))),
-        _ => None,
+    let (shape1, shape2) = (&*c1.shape.0, &*c2.shape.0);
+    let mut scale = c1
+        .clip_size
+        .zip(c2.clip_size)
+        .map_or(1.0, |(size1, size2)| clip_scale(size1.min(size2)));
+    let boxes = if scale == 1.0 {
+        None
+    } else {
+        ClipShape::of(shape1).zip(ClipShape::of(shape2))
     };
-    let result = match clip {
-        // Small boxes and cylinders are clipped scaled up, their points scaled back.
-        Some((s1, s2, scale)) if scale != 1.0 => {
-            scale_points(&mut state.manifolds, scale);
-            let result = DefaultQueryDispatcher.contact_manifolds(
-                &Pose::from_parts(pos12.translation * scale, pos12.rotation),
-                s1.scaled(scale).shape(),
-                s2.scaled(scale).shape(),
-                prediction * scale,
-                &mut state.manifolds,
-                &mut state.workspace,
-            );
-            scale_points(&mut state.manifolds, scale.recip());
-            result
+    if scale != 1.0 && boxes.is_none() {
+        // Hulls and compounds are scaled once for the pair, not at every query.
+        let ids = (shape_id(c1), shape_id(c2));
+        let current = state.scaled.as_ref();
+        if !current.is_some_and(|s| s.ids == ids && s.scale == scale) {
+            state.scaled = scaled_shape(shape1, scale)
+                .zip(scaled_shape(shape2, scale))
+                .map(|shapes| Box::new(ScaledShapes { ids, scale, shapes }));
         }
-        _ => DefaultQueryDispatcher.contact_manifolds(
+        if state.scaled.is_none() {
+            scale = 1.0;
+        }
+    }
+    let result = if scale == 1.0 {
+        DefaultQueryDispatcher.contact_manifolds(
             pos12,
-            &*c1.shape.0,
-            &*c2.shape.0,
+            shape1,
+            shape2,
             prediction,
             &mut state.manifolds,
             &mut state.workspace,
-        ),
+        )
+    } else {
+        // Small shapes are clipped scaled up, their points scaled back.
+        let scaled_pose = Pose::from_parts(pos12.translation * scale, pos12.rotation);
+        scale_manifolds(&mut state.manifolds, scale);
+        // Boxes and cylinders are copied scaled on the stack.
+        let copies = boxes.map(|(s1, s2)| (s1.scaled(scale), s2.scaled(scale)));
+        let (scaled1, scaled2) = match (&copies, &state.scaled) {
+            (Some((s1, s2)), _) => (s1.shape(), s2.shape()),
+            (None, Some(s)) => (&*s.shapes.0.0, &*s.shapes.1.0),
+            (None, None) => unreachable!("scale is 1 without scaled copies"),
+        };
+        let result = DefaultQueryDispatcher.contact_manifolds(
+            &scaled_pose,
+            scaled1,
+            scaled2,
+            prediction * scale,
+            &mut state.manifolds,
+            &mut state.workspace,
+        );
+        scale_manifolds(&mut state.manifolds, scale.recip());
+        result
     };
     if result.is_err() {
         // An unsupported pair (two half-spaces): no contact, by definition of the shapes.
@@ -1746,12 +1787,13 @@ fn compute(
     };
 }
 
-/// The size (largest half dimension, m) at or above which a pair of boxes or cylinders is
-/// clipped at its own size ([`clip_scale`]).
+/// The size (largest half dimension, m; [`clip_size`]) at or above which a pair of shapes
+/// is clipped at its own size ([`clip_scale`]).
 const CLIP_SIZE: f32 = 0.05;
 
-/// The factor by which a pair of boxes or cylinders is scaled for parry's clipping of their
-/// faces, from the smaller of their sizes ([`ClipShape::size`]): 1 at [`CLIP_SIZE`] or
+/// The factor by which a pair of boxes, cylinders, convex hulls or compounds is scaled for
+/// parry's clipping of their faces, from the smaller of their sizes ([`clip_size`]): 1 at
+/// [`CLIP_SIZE`] or
 /// above, else the least power of four that brings it there. A power of four scales every
 /// operation exactly in f32 (square roots included), so the scaled result is the exact scaling
 /// of one at the shapes' own size but for parry's absolute tolerances.
@@ -1821,18 +1863,91 @@ impl ClipShape {
     }
 }
 
-/// Scales every point of `manifolds` (both local points and the separation) by `scale`.
-fn scale_points(manifolds: &mut [Manifold], scale: f32) {
-    if scale == 1.0 {
-        return;
-    }
+/// Scales every point of `manifolds` (both local points and the separation), and the
+/// positions of composite shapes' parts, by `scale`.
+fn scale_manifolds(manifolds: &mut [Manifold], scale: f32) {
     for m in manifolds {
         for p in &mut m.points {
             p.local_p1 *= scale;
             p.local_p2 *= scale;
             p.dist *= scale;
         }
+        if let Some(poses) = &mut m.subshape_poses {
+            for pose in [&mut poses.pos1, &mut poses.pos2].into_iter().flatten() {
+                pose.translation *= scale;
+            }
+        }
     }
+}
+
+/// The size that decides how a shape is clipped ([`clip_scale`]): a box's or a cylinder's
+/// ([`ClipShape::size`]), half the largest side of a convex hull's bounding box, the smallest
+/// of a compound's parts; `None` for shapes parry does not clip by faces (balls, capsules,
+/// half-spaces, meshes), or which `scaled_shape` cannot scale. Each collider keeps its own
+/// (`Collider::clip_size`).
+pub(crate) fn clip_size(shape: &dyn Shape) -> Option<f32> {
+    if let Some(s) = ClipShape::of(shape) {
+        return Some(s.size());
+    }
+    if shape.as_convex_polyhedron().is_some() {
+        return Some(shape.compute_local_aabb().half_extents().max_element());
+    }
+    let parts = shape.as_compound()?.shapes();
+    if !parts.iter().all(|(_, part)| scalable(&*part.0)) {
+        return None;
+    }
+    parts
+        .iter()
+        .filter_map(|(_, part)| clip_size(&*part.0))
+        .min_by(f32::total_cmp)
+}
+
+/// Whether [`scaled_shape`] can scale `shape`.
+fn scalable(shape: &dyn Shape) -> bool {
+    ClipShape::of(shape).is_some()
+        || shape.as_ball().is_some()
+        || shape.as_capsule().is_some()
+        || shape.as_convex_polyhedron().is_some()
+        || shape
+            .as_compound()
+            .is_some_and(|c| c.shapes().iter().all(|(_, part)| scalable(&*part.0)))
+}
+
+/// A copy of `shape` scaled by `scale`: balls, boxes, capsules, cylinders, convex hulls and
+/// compounds of them; `None` for any other shape.
+fn scaled_shape(shape: &dyn Shape, scale: f32) -> Option<SharedShape> {
+    if let Some(s) = ClipShape::of(shape) {
+        return Some(match s.scaled(scale) {
+            ClipShape::Cuboid(c) => SharedShape::new(c),
+            ClipShape::Cylinder(c) => SharedShape::new(c),
+        });
+    }
+    if let Some(ball) = shape.as_ball() {
+        return Some(SharedShape::ball(ball.radius * scale));
+    }
+    if let Some(capsule) = shape.as_capsule() {
+        let segment = capsule.segment;
+        return Some(SharedShape::capsule(
+            segment.a * scale,
+            segment.b * scale,
+            capsule.radius * scale,
+        ));
+    }
+    if let Some(hull) = shape.as_convex_polyhedron() {
+        return hull
+            .clone()
+            .scaled(Vec3::splat(scale))
+            .map(SharedShape::new);
+    }
+    let parts = shape.as_compound()?.shapes();
+    let scaled = parts
+        .iter()
+        .map(|(pose, part)| {
+            let pose = Pose::from_parts(pose.translation * scale, pose.rotation);
+            scaled_shape(&*part.0, scale).map(|part| (pose, part))
+        })
+        .collect::<Option<Vec<_>>>()?;
+    Some(SharedShape::compound(scaled))
 }
 
 /// The gap (m) between two convex shapes along the unit direction `axis` of collider 1's
