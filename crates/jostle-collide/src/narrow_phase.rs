@@ -6,8 +6,8 @@
 //!
 //! Each pair keeps its parry manifolds and workspace from step to step, so parry's coherence
 //! (and its feature ids) carries over; each manifold is reduced to at most four points
-//! ([`crate::reduce`]; boxes, cylinders, hulls and compounds smaller than 5 cm are clipped
-//! scaled up, see `clip_scale`); each point carries the resolver's accumulated impulse, matched by
+//! ([`crate::reduce`]; boxes, cylinders, capsules, hulls and compounds smaller than 5 cm are
+//! clipped scaled up, see `clip_scale`); each point carries the resolver's accumulated impulse, matched by
 //! (sub-shapes, feature ids) when the manifold is recomputed. A pair whose relative pose moved
 //! less than the reuse tolerances since its manifold was computed is not recomputed: only its
 //! separations are refreshed, and its world points are rebuilt from the local points, so they
@@ -28,7 +28,7 @@ use parry3d::math::Pose;
 use parry3d::query::{
     ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
 };
-use parry3d::shape::{Cuboid, Cylinder, PackedFeatureId, Shape, SharedShape};
+use parry3d::shape::{Capsule, Cuboid, Cylinder, PackedFeatureId, Shape, SharedShape};
 use std::borrow::Cow;
 
 /// One contact point between two bodies, ready for the resolver.
@@ -1791,7 +1791,8 @@ fn compute(
 /// is clipped at its own size ([`clip_scale`]).
 const CLIP_SIZE: f32 = 0.05;
 
-/// The factor by which a pair of boxes, cylinders, convex hulls or compounds is scaled for
+/// The factor by which a pair of boxes, cylinders, capsules, convex hulls or compounds is
+/// scaled for
 /// parry's clipping of their faces, from the smaller of their sizes ([`clip_size`]): 1 at
 /// [`CLIP_SIZE`] or
 /// above, else the least power of four that brings it there. A power of four scales every
@@ -1820,12 +1821,14 @@ fn clip_scale(size: f32) -> f32 {
     scale
 }
 
-/// A shape whose contacts parry finds by clipping polygonal faces (a box, or a cylinder,
-/// whose caps it clips as squares), copied so that it can be scaled ([`clip_scale`]).
+/// A shape whose contacts parry finds by clipping polygonal features (a box; a cylinder, whose
+/// caps it clips as squares; a capsule, whose segment it clips against a face), copied so
+/// that it can be scaled ([`clip_scale`]).
 #[derive(Clone, Copy)]
 enum ClipShape {
     Cuboid(Cuboid),
     Cylinder(Cylinder),
+    Capsule(Capsule),
 }
 
 impl ClipShape {
@@ -1834,15 +1837,17 @@ impl ClipShape {
             .as_cuboid()
             .map(|c| Self::Cuboid(*c))
             .or_else(|| shape.as_cylinder().map(|c| Self::Cylinder(*c)))
+            .or_else(|| shape.as_capsule().map(|c| Self::Capsule(*c)))
     }
 
     /// The largest half dimension (m): the largest half extent of a box, the larger of a
-    /// cylinder's half height and radius. The largest, not the smallest: a coin's caps are
+    /// cylinder's half height and radius, a capsule's half length with its radius. The largest, not the smallest: a coin's caps are
     /// clipped by edges of its radius's length, whatever its thickness.
     fn size(&self) -> f32 {
         match self {
             Self::Cuboid(c) => c.half_extents.max_element(),
             Self::Cylinder(c) => c.half_height.max(c.radius),
+            Self::Capsule(c) => c.half_height() + c.radius,
         }
     }
 
@@ -1852,6 +1857,11 @@ impl ClipShape {
             Self::Cylinder(c) => {
                 Self::Cylinder(Cylinder::new(c.half_height * scale, c.radius * scale))
             }
+            Self::Capsule(c) => Self::Capsule(Capsule::new(
+                c.segment.a * scale,
+                c.segment.b * scale,
+                c.radius * scale,
+            )),
         }
     }
 
@@ -1859,6 +1869,7 @@ impl ClipShape {
         match self {
             Self::Cuboid(c) => c,
             Self::Cylinder(c) => c,
+            Self::Capsule(c) => c,
         }
     }
 }
@@ -1880,9 +1891,9 @@ fn scale_manifolds(manifolds: &mut [Manifold], scale: f32) {
     }
 }
 
-/// The size that decides how a shape is clipped ([`clip_scale`]): a box's or a cylinder's
-/// ([`ClipShape::size`]), half the largest side of a convex hull's bounding box, the smallest
-/// of a compound's parts; `None` for shapes parry does not clip by faces (balls, capsules,
+/// The size that decides how a shape is clipped ([`clip_scale`]): a box's, a cylinder's or a
+/// capsule's ([`ClipShape::size`]), half the largest side of a convex hull's bounding box, the
+/// smallest of a compound's parts; `None` for shapes parry does not clip by features (balls,
 /// half-spaces, meshes), or which `scaled_shape` cannot scale. Each collider keeps its own
 /// (`Collider::clip_size`).
 pub(crate) fn clip_size(shape: &dyn Shape) -> Option<f32> {
@@ -1906,7 +1917,6 @@ pub(crate) fn clip_size(shape: &dyn Shape) -> Option<f32> {
 fn scalable(shape: &dyn Shape) -> bool {
     ClipShape::of(shape).is_some()
         || shape.as_ball().is_some()
-        || shape.as_capsule().is_some()
         || shape.as_convex_polyhedron().is_some()
         || shape
             .as_compound()
@@ -1920,18 +1930,11 @@ fn scaled_shape(shape: &dyn Shape, scale: f32) -> Option<SharedShape> {
         return Some(match s.scaled(scale) {
             ClipShape::Cuboid(c) => SharedShape::new(c),
             ClipShape::Cylinder(c) => SharedShape::new(c),
+            ClipShape::Capsule(c) => SharedShape::new(c),
         });
     }
     if let Some(ball) = shape.as_ball() {
         return Some(SharedShape::ball(ball.radius * scale));
-    }
-    if let Some(capsule) = shape.as_capsule() {
-        let segment = capsule.segment;
-        return Some(SharedShape::capsule(
-            segment.a * scale,
-            segment.b * scale,
-            capsule.radius * scale,
-        ));
     }
     if let Some(hull) = shape.as_convex_polyhedron() {
         return hull
