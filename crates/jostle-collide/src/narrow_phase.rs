@@ -7,8 +7,8 @@
 //! Each pair keeps its parry manifolds and workspace from step to step, so parry's coherence
 //! (and its feature ids) carries over; each manifold is reduced to at most four points
 //! ([`crate::reduce`]; boxes, cylinders, capsules, hulls and compounds smaller than 5 cm are
-//! clipped scaled up, see `clip_scale`); each point carries the resolver's accumulated impulse, matched by
-//! (sub-shapes, feature ids) when the manifold is recomputed. A pair whose relative pose moved
+//! clipped scaled up, see `clip_scale`); each point carries the resolver's accumulated
+//! impulse, matched by (sub-shapes, feature ids) when the manifold is recomputed. A pair whose relative pose moved
 //! less than the reuse tolerances since its manifold was computed is not recomputed: only its
 //! separations are refreshed, and its world points are rebuilt from the local points, so they
 //! follow the bodies. A pair whose query found no contact keeps a direction along which its
@@ -239,8 +239,8 @@ struct PairState {
     /// `None` while the pair has contacts, or none was found.
     #[cfg_attr(feature = "serde", serde(default))]
     apart: Option<Vec3>,
-    /// The pair's shapes scaled for clipping, when they are small and not both boxes or
-    /// cylinders ([`ScaledShapes`]); rebuilt after a restore.
+    /// The pair's shapes scaled for clipping, when they are small and not both boxes,
+    /// cylinders or capsules ([`ScaledShapes`]); rebuilt after a restore.
     #[cfg_attr(feature = "serde", serde(skip))]
     scaled: Option<Box<ScaledShapes>>,
 }
@@ -1701,60 +1701,13 @@ fn compute(
             .iter()
             .map(move |p| ((m.subshape1, m.subshape2, p.fid1, p.fid2), p.data))
     }));
-    let (shape1, shape2) = (&*c1.shape.0, &*c2.shape.0);
-    let mut scale = c1
-        .clip_size
-        .zip(c2.clip_size)
-        .map_or(1.0, |(size1, size2)| clip_scale(size1.min(size2)));
-    let boxes = if scale == 1.0 {
-        None
-    } else {
-        ClipShape::of(shape1).zip(ClipShape::of(shape2))
-    };
-    if scale != 1.0 && boxes.is_none() {
-        // Hulls and compounds are scaled once for the pair, not at every query.
-        let ids = (shape_id(c1), shape_id(c2));
-        let current = state.scaled.as_ref();
-        if !current.is_some_and(|s| s.ids == ids && s.scale == scale) {
-            state.scaled = scaled_shape(shape1, scale)
-                .zip(scaled_shape(shape2, scale))
-                .map(|shapes| Box::new(ScaledShapes { ids, scale, shapes }));
-        }
-        if state.scaled.is_none() {
-            scale = 1.0;
-        }
-    }
-    let result = if scale == 1.0 {
-        DefaultQueryDispatcher.contact_manifolds(
-            pos12,
-            shape1,
-            shape2,
-            prediction,
-            &mut state.manifolds,
-            &mut state.workspace,
-        )
-    } else {
-        // Small shapes are clipped scaled up, their points scaled back.
-        let scaled_pose = Pose::from_parts(pos12.translation * scale, pos12.rotation);
-        scale_manifolds(&mut state.manifolds, scale);
-        // Boxes and cylinders are copied scaled on the stack.
-        let copies = boxes.map(|(s1, s2)| (s1.scaled(scale), s2.scaled(scale)));
-        let (scaled1, scaled2) = match (&copies, &state.scaled) {
-            (Some((s1, s2)), _) => (s1.shape(), s2.shape()),
-            (None, Some(s)) => (&*s.shapes.0.0, &*s.shapes.1.0),
-            (None, None) => unreachable!("scale is 1 without scaled copies"),
-        };
-        let result = DefaultQueryDispatcher.contact_manifolds(
-            &scaled_pose,
-            scaled1,
-            scaled2,
-            prediction * scale,
-            &mut state.manifolds,
-            &mut state.workspace,
-        );
-        scale_manifolds(&mut state.manifolds, scale.recip());
-        result
-    };
+    let PairState {
+        manifolds,
+        workspace,
+        scaled,
+        ..
+    } = state;
+    let result = query(pos12, c1, c2, prediction, manifolds, workspace, scaled);
     if result.is_err() {
         // An unsupported pair (two half-spaces): no contact, by definition of the shapes.
         state.manifolds.clear();
@@ -1787,17 +1740,79 @@ fn compute(
     };
 }
 
+/// parry's contact manifolds of `c1` and `c2` at `pos12` (`c2`'s pose in `c1`'s frame),
+/// updated in `manifolds` from what they hold: small shapes clipped scaled up
+/// ([`clip_scale`]), with the pair's scaled copies of hulls and compounds kept in `scaled`.
+/// An error for an unsupported pair of shapes.
+fn query(
+    pos12: &Pose,
+    c1: &Collider,
+    c2: &Collider,
+    prediction: f32,
+    manifolds: &mut Vec<Manifold>,
+    workspace: &mut Option<ContactManifoldsWorkspace>,
+    scaled: &mut Option<Box<ScaledShapes>>,
+) -> Result<(), parry3d::query::Unsupported> {
+    let (shape1, shape2) = (&*c1.shape.0, &*c2.shape.0);
+    let mut scale = c1
+        .clip_size
+        .zip(c2.clip_size)
+        .map_or(1.0, |(size1, size2)| clip_scale(size1.min(size2)));
+    let boxes = if scale == 1.0 {
+        None
+    } else {
+        ClipShape::of(shape1).zip(ClipShape::of(shape2))
+    };
+    if scale != 1.0 && boxes.is_none() {
+        // Hulls and compounds are scaled once for the pair, not at every query.
+        let ids = (shape_id(c1), shape_id(c2));
+        let current = scaled.as_ref();
+        if !current.is_some_and(|s| s.ids == ids && s.scale == scale) {
+            *scaled = scaled_shape(shape1, scale)
+                .zip(scaled_shape(shape2, scale))
+                .map(|shapes| Box::new(ScaledShapes { ids, scale, shapes }));
+        }
+        if scaled.is_none() {
+            scale = 1.0;
+        }
+    }
+    if scale == 1.0 {
+        DefaultQueryDispatcher
+            .contact_manifolds(pos12, shape1, shape2, prediction, manifolds, workspace)
+    } else {
+        // Small shapes are clipped scaled up, their points scaled back.
+        let scaled_pose = Pose::from_parts(pos12.translation * scale, pos12.rotation);
+        scale_manifolds(manifolds, scale);
+        // Boxes, cylinders and capsules are copied scaled on the stack.
+        let copies = boxes.map(|(s1, s2)| (s1.scaled(scale), s2.scaled(scale)));
+        let (scaled1, scaled2) = match (&copies, &*scaled) {
+            (Some((s1, s2)), _) => (s1.shape(), s2.shape()),
+            (None, Some(s)) => (&*s.shapes.0.0, &*s.shapes.1.0),
+            (None, None) => unreachable!("scale is 1 without scaled copies"),
+        };
+        let result = DefaultQueryDispatcher.contact_manifolds(
+            &scaled_pose,
+            scaled1,
+            scaled2,
+            prediction * scale,
+            manifolds,
+            workspace,
+        );
+        scale_manifolds(manifolds, scale.recip());
+        result
+    }
+}
+
 /// The size (largest half dimension, m; [`clip_size`]) at or above which a pair of shapes
 /// is clipped at its own size ([`clip_scale`]).
 const CLIP_SIZE: f32 = 0.05;
 
 /// The factor by which a pair of boxes, cylinders, capsules, convex hulls or compounds is
-/// scaled for
-/// parry's clipping of their faces, from the smaller of their sizes ([`clip_size`]): 1 at
-/// [`CLIP_SIZE`] or
-/// above, else the least power of four that brings it there. A power of four scales every
-/// operation exactly in f32 (square roots included), so the scaled result is the exact scaling
-/// of one at the shapes' own size but for parry's absolute tolerances.
+/// scaled for parry's clipping of their faces, from the smaller of their sizes
+/// ([`clip_size`]): 1 at [`CLIP_SIZE`] or above, else the least power of four that brings it
+/// there. A power of four scales every operation exactly in f32 (square roots included), so
+/// the scaled result is the exact scaling of one at the shapes' own size but for parry's
+/// absolute tolerances.
 ///
 /// Those tolerances are why: parry's 2D edge intersection takes two edges as parallel when
 /// |d₁|²·|d₂|²·sin²θ falls below f32's epsilon, so edges shorter than about 1.9 cm never
@@ -1841,8 +1856,9 @@ impl ClipShape {
     }
 
     /// The largest half dimension (m): the largest half extent of a box, the larger of a
-    /// cylinder's half height and radius, a capsule's half length with its radius. The largest, not the smallest: a coin's caps are
-    /// clipped by edges of its radius's length, whatever its thickness.
+    /// cylinder's half height and radius, a capsule's half length with its radius. The
+    /// largest, not the smallest: a coin's caps are clipped by edges of its radius's length,
+    /// whatever its thickness.
     fn size(&self) -> f32 {
         match self {
             Self::Cuboid(c) => c.half_extents.max_element(),
@@ -2110,16 +2126,16 @@ fn afresh(
 ) -> Option<(Vec<Manifold>, Option<ContactManifoldsWorkspace>)> {
     let mut manifolds = Vec::new();
     let mut workspace = None;
-    DefaultQueryDispatcher
-        .contact_manifolds(
-            pos12,
-            &*c1.shape.0,
-            &*c2.shape.0,
-            prediction,
-            &mut manifolds,
-            &mut workspace,
-        )
-        .ok()?;
+    query(
+        pos12,
+        c1,
+        c2,
+        prediction,
+        &mut manifolds,
+        &mut workspace,
+        &mut None,
+    )
+    .ok()?;
     Some((manifolds, workspace))
 }
 
