@@ -245,13 +245,13 @@ struct PairState {
     scaled: Option<Box<ScaledShapes>>,
 }
 
-/// Copies of a pair's shapes scaled by `scale` for clipping ([`clip_scale`]), kept while the
-/// pair lives: a convex hull or a compound is rebuilt to be scaled, once, not every query.
+/// Copies of a pair's shapes scaled for clipping ([`clip_scale`], a function of the shapes
+/// alone), kept while the pair lives: a convex hull or a compound is rebuilt to be scaled,
+/// once, not every query.
 #[derive(Clone)]
 struct ScaledShapes {
     /// The shapes scaled ([`shape_id`]).
     ids: (usize, usize),
-    scale: f32,
     shapes: (SharedShape, SharedShape),
 }
 
@@ -1766,11 +1766,10 @@ fn query(
     if scale != 1.0 && boxes.is_none() {
         // Hulls and compounds are scaled once for the pair, not at every query.
         let ids = (shape_id(c1), shape_id(c2));
-        let current = scaled.as_ref();
-        if !current.is_some_and(|s| s.ids == ids && s.scale == scale) {
+        if scaled.as_ref().is_none_or(|s| s.ids != ids) {
             *scaled = scaled_shape(shape1, scale)
                 .zip(scaled_shape(shape2, scale))
-                .map(|shapes| Box::new(ScaledShapes { ids, scale, shapes }));
+                .map(|shapes| Box::new(ScaledShapes { ids, shapes }));
         }
         if scaled.is_none() {
             scale = 1.0;

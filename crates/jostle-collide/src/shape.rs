@@ -86,15 +86,9 @@ pub struct CompoundPart {
     #[cfg_attr(feature = "serde", serde(default))]
     pub position: Vec3,
     /// Orientation of the part in the compound's frame (normalized on build). Default (in
-    /// scene files): the compound's own, the identity.
-    #[cfg_attr(feature = "serde", serde(default = "identity_rotation"))]
+    /// scene files): the compound's own, the identity (`Quat`'s default).
+    #[cfg_attr(feature = "serde", serde(default))]
     pub rotation: Quat,
-}
-
-/// The default rotation of a [`CompoundPart`] read from a file.
-#[cfg(feature = "serde")]
-fn identity_rotation() -> Quat {
-    Quat::IDENTITY
 }
 
 /// A collision shape, described by plain numbers (SI units, shape's own frame).
