@@ -5,7 +5,8 @@
 //! positive on overlap), [`CollisionEvent`]s and [`NarrowStats`].
 //!
 //! Each pair keeps its parry manifolds and workspace from step to step, so parry's coherence
-//! (and its feature ids) carries over; each manifold is reduced to at most four points
+//! (and its feature ids) carries over, except where a shape's support point shows that a
+//! kept manifold misses overlap (`misses_a_deeper_point`: a box turning about an edge); each manifold is reduced to at most four points
 //! ([`crate::reduce`]; boxes, cylinders, capsules, hulls and compounds smaller than 5 cm are
 //! clipped scaled up, see `clip_scale`); each point carries the resolver's accumulated
 //! impulse, matched by (sub-shapes, feature ids) when the manifold is recomputed. A pair whose relative pose moved
@@ -1707,7 +1708,19 @@ fn compute(
         scaled,
         ..
     } = state;
-    let result = query(pos12, c1, c2, prediction, manifolds, workspace, scaled);
+    // parry kept the manifold (its coherence) when its normal is the one it had, to the bit.
+    let normal_before = match &manifolds[..] {
+        [m] => Some(m.local_n1),
+        _ => None,
+    };
+    let mut result = query(pos12, c1, c2, prediction, manifolds, workspace, scaled);
+    let kept = matches!((&manifolds[..], normal_before), ([m], Some(n)) if m.local_n1 == n);
+    if result.is_ok() && kept && misses_a_deeper_point(manifolds, c1, c2, pos12) {
+        for m in manifolds.iter_mut() {
+            m.mark_shapes_deformed();
+        }
+        result = query(pos12, c1, c2, prediction, manifolds, workspace, scaled);
+    }
     if result.is_err() {
         // An unsupported pair (two half-spaces): no contact, by definition of the shapes.
         state.manifolds.clear();
@@ -1800,6 +1813,58 @@ fn query(
         scale_manifolds(manifolds, scale.recip());
         result
     }
+}
+
+/// How much deeper (m) than a convex pair's deepest point either shape's deepest point along
+/// the manifold's normal may reach before the manifold is computed again
+/// ([`misses_a_deeper_point`]).
+const MISSED_DEPTH: f32 = 1e-3;
+
+/// Whether the single manifold of two convex shapes misses overlap: either shape's support
+/// point along the manifold's normal lies more than [`MISSED_DEPTH`] deeper past the other's
+/// contact plane than the manifold's deepest point.
+///
+/// parry keeps a manifold's points (refreshing their separations only) while its normal turns
+/// less than 1° and no point moves 1 mm. Turning about an edge, the points on the edge do not
+/// move, and the far side comes into contact unseen: a 10 m box of a column rocking on an
+/// edge of the box below had its far edge 146 mm deep before parry looked again, and the
+/// push-out then threw the column over (benches/RESULTS.md, "parry's coherence and a box
+/// turning about an edge"). Computing every moved pair's manifold afresh instead loses the
+/// points' persistence, and with it four cases of the stability family. A support point
+/// beyond the other shape's face (a large box on a small one) is no overlap; such a pair is
+/// computed afresh, which costs time only.
+fn misses_a_deeper_point(
+    manifolds: &[Manifold],
+    c1: &Collider,
+    c2: &Collider,
+    pos12: &Pose,
+) -> bool {
+    let [m] = manifolds else {
+        return false;
+    };
+    if m.points.is_empty() || m.subshape_pos1().is_some() || m.subshape_pos2().is_some() {
+        return false;
+    }
+    let (Some(s1), Some(s2)) = (c1.shape.0.as_support_map(), c2.shape.0.as_support_map()) else {
+        return false;
+    };
+    let n = m.local_n1;
+    // Shape 1's contact plane (its points' highest level along n) and shape 2's (its points'
+    // lowest), in shape 1's frame.
+    let plane1 = m
+        .points
+        .iter()
+        .map(|p| p.local_p1.dot(n))
+        .fold(f32::MIN, f32::max);
+    let plane2 = m
+        .points
+        .iter()
+        .map(|p| (pos12 * p.local_p2).dot(n))
+        .fold(f32::MAX, f32::min);
+    let deepest = m.points.iter().map(|p| -p.dist).fold(f32::MIN, f32::max);
+    let reach2 = plane1 - (pos12 * s2.local_support_point(pos12.rotation.inverse() * -n)).dot(n);
+    let reach1 = s1.local_support_point(n).dot(n) - plane2;
+    reach1.max(reach2) > deepest + MISSED_DEPTH
 }
 
 /// The size (largest half dimension, m; [`clip_size`]) at or above which a pair of shapes
