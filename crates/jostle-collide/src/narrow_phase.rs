@@ -6,7 +6,7 @@
 //!
 //! Each pair keeps its parry manifolds and workspace from step to step, so parry's coherence
 //! (and its feature ids) carries over, except where a shape's support point shows that a
-//! kept manifold misses overlap (`misses_a_deeper_point`: a box turning about an edge); each manifold is reduced to at most four points
+//! manifold misses overlap (`misses_a_deeper_point`: a box turning about an edge); each manifold is reduced to at most four points
 //! ([`crate::reduce`]; boxes, cylinders, capsules, hulls and compounds smaller than 5 cm are
 //! clipped scaled up, see `clip_scale`); each point carries the resolver's accumulated
 //! impulse, matched by (sub-shapes, feature ids) when the manifold is recomputed. A pair whose relative pose moved
@@ -1708,14 +1708,12 @@ fn compute(
         scaled,
         ..
     } = state;
-    // parry kept the manifold (its coherence) when its normal is the one it had, to the bit.
-    let normal_before = match &manifolds[..] {
-        [m] => Some(m.local_n1),
-        _ => None,
-    };
     let mut result = query(pos12, c1, c2, prediction, manifolds, workspace, scaled);
-    let kept = matches!((&manifolds[..], normal_before), ([m], Some(n)) if m.local_n1 == n);
-    if result.is_ok() && kept && misses_a_deeper_point(manifolds, c1, c2, pos12) {
+    if result.is_ok()
+        && manifolds
+            .iter()
+            .any(|m| misses_a_deeper_point(m, c1, c2, pos12))
+    {
         for m in manifolds.iter_mut() {
             m.mark_shapes_deformed();
         }
@@ -1815,14 +1813,20 @@ fn query(
     }
 }
 
-/// How much deeper (m) than a convex pair's deepest point either shape's deepest point along
-/// the manifold's normal may reach before the manifold is computed again
-/// ([`misses_a_deeper_point`]).
-const MISSED_DEPTH: f32 = 1e-3;
+/// How much deeper (m) than a manifold's deepest point either shape's deepest point along
+/// its normal may reach before the manifold is computed again ([`misses_a_deeper_point`]):
+/// half the default prediction distance. At 1 mm the check also overruled parry's coherence
+/// wherever a kept normal had turned a milliradian across a unit box, and the collapse of
+/// `assets/pyramid_heavy_top.ron` stepped at 1 s under the Millington resolver took another
+/// course, one that gained 38% of its energy (benches/RESULTS.md, "parry's coherence and a
+/// box turning about an edge").
+const MISSED_DEPTH: f32 = 1e-2;
 
-/// Whether the single manifold of two convex shapes misses overlap: either shape's support
-/// point along the manifold's normal lies more than [`MISSED_DEPTH`] deeper past the other's
-/// contact plane than the manifold's deepest point.
+/// Whether the manifold `m` of `c1` and `c2` at `pos12` misses overlap: either shape's (or,
+/// for a composite shape, the manifold's part's) support point along the manifold's normal
+/// lies more than [`MISSED_DEPTH`] deeper past the other's contact plane than the manifold's
+/// deepest point. A shape with no support map (a half-space, a part that is no convex shape)
+/// is not checked.
 ///
 /// parry keeps a manifold's points (refreshing their separations only) while its normal turns
 /// less than 1° and no point moves 1 mm. Turning about an edge, the points on the edge do not
@@ -1833,38 +1837,61 @@ const MISSED_DEPTH: f32 = 1e-3;
 /// points' persistence, and with it four cases of the stability family. A support point
 /// beyond the other shape's face (a large box on a small one) is no overlap; such a pair is
 /// computed afresh, which costs time only.
-fn misses_a_deeper_point(
-    manifolds: &[Manifold],
-    c1: &Collider,
-    c2: &Collider,
-    pos12: &Pose,
-) -> bool {
-    let [m] = manifolds else {
-        return false;
-    };
-    if m.points.is_empty() || m.subshape_pos1().is_some() || m.subshape_pos2().is_some() {
+///
+/// The check runs on parry's fresh answers too: for hulls and cylinders stacked exactly
+/// touching, parry answered with one point and a sideways normal (a 7.5 mm hull cube on
+/// another, normal along z; coins the same), and checked only where parry kept a manifold, a
+/// column of five such cubes moved 1.8 mm before it was caught. Computed again (from the
+/// manifold's points, `mark_shapes_deformed`), the answer is the face's four points.
+fn misses_a_deeper_point(m: &Manifold, c1: &Collider, c2: &Collider, pos12: &Pose) -> bool {
+    if m.points.is_empty() {
         return false;
     }
-    let (Some(s1), Some(s2)) = (c1.shape.0.as_support_map(), c2.shape.0.as_support_map()) else {
-        return false;
-    };
-    let n = m.local_n1;
-    // Shape 1's contact plane (its points' highest level along n) and shape 2's (its points'
-    // lowest), in shape 1's frame.
-    let plane1 = m
-        .points
-        .iter()
-        .map(|p| p.local_p1.dot(n))
-        .fold(f32::MIN, f32::max);
-    let plane2 = m
-        .points
-        .iter()
-        .map(|p| (pos12 * p.local_p2).dot(n))
-        .fold(f32::MAX, f32::min);
-    let deepest = m.points.iter().map(|p| -p.dist).fold(f32::MIN, f32::max);
-    let reach2 = plane1 - (pos12 * s2.local_support_point(pos12.rotation.inverse() * -n)).dot(n);
-    let reach1 = s1.local_support_point(n).dot(n) - plane2;
-    reach1.max(reach2) > deepest + MISSED_DEPTH
+    let pos = manifold_pos12(m, pos12);
+    with_part(&*c1.shape.0, m.subshape1, |s1| {
+        with_part(&*c2.shape.0, m.subshape2, |s2| {
+            let n = m.local_n1;
+            // Shape 1's contact plane (its points' highest level along n) and shape 2's (its
+            // points' lowest), in shape 1's (part's) frame.
+            let plane1 = m
+                .points
+                .iter()
+                .map(|p| p.local_p1.dot(n))
+                .fold(f32::MIN, f32::max);
+            let plane2 = m
+                .points
+                .iter()
+                .map(|p| (pos * p.local_p2).dot(n))
+                .fold(f32::MAX, f32::min);
+            let deepest = m.points.iter().map(|p| -p.dist).fold(f32::MIN, f32::max);
+            let reach2 =
+                plane1 - (pos * s2.local_support_point(pos.rotation.inverse() * -n)).dot(n);
+            let reach1 = s1.local_support_point(n).dot(n) - plane2;
+            reach1.max(reach2) > deepest + MISSED_DEPTH
+        })
+    })
+}
+
+/// `f` of `shape`'s support map, or of its part `part`'s for a composite shape; false where
+/// there is none.
+fn with_part(
+    shape: &dyn Shape,
+    part: u32,
+    f: impl FnOnce(&dyn parry3d::shape::SupportMap) -> bool,
+) -> bool {
+    match shape.as_composite_shape() {
+        Some(composite) => {
+            let mut f = Some(f);
+            let mut answer = false;
+            composite.map_part_at(part, &mut |_, shape, _| {
+                if let (Some(support), Some(f)) = (shape.as_support_map(), f.take()) {
+                    answer = f(support);
+                }
+            });
+            answer
+        }
+        None => shape.as_support_map().is_some_and(f),
+    }
 }
 
 /// The size (largest half dimension, m; [`clip_size`]) at or above which a pair of shapes
