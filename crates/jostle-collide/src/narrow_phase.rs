@@ -6,10 +6,11 @@
 //!
 //! Each pair keeps its parry manifolds and workspace from step to step, so parry's coherence
 //! (and its feature ids) carries over, except where a shape's support point shows that a
-//! manifold misses overlap (`misses_a_deeper_point`: a box turning about an edge); each manifold is reduced to at most four points
-//! ([`crate::reduce`]; boxes, cylinders, capsules, hulls and compounds smaller than 5 cm are
-//! clipped scaled up, see `clip_scale`); each point carries the resolver's accumulated
-//! impulse, matched by (sub-shapes, feature ids) when the manifold is recomputed. A pair whose relative pose moved
+//! manifold misses overlap (`misses_a_deeper_point`: a box turning about an edge); each
+//! manifold is reduced to at most four points ([`crate::reduce`]; boxes, cylinders, capsules,
+//! hulls and compounds smaller than 5 cm are clipped scaled up, see `clip_scale`); each point
+//! carries the resolver's accumulated impulse, matched by (sub-shapes, feature ids) when the
+//! manifold is recomputed. A pair whose relative pose moved
 //! less than the reuse tolerances since its manifold was computed is not recomputed: only its
 //! separations are refreshed, and its world points are rebuilt from the local points, so they
 //! follow the bodies. A pair whose query found no contact keeps a direction along which its
