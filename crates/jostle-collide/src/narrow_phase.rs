@@ -1864,11 +1864,9 @@ fn misses_a_deeper_point(m: &Manifold, c1: &Collider, c2: &Collider, pos12: &Pos
                 .iter()
                 .map(|p| (pos * p.local_p2).dot(n))
                 .fold(f32::MAX, f32::min);
-            let deepest = m.points.iter().map(|p| -p.dist).fold(f32::MIN, f32::max);
-            let reach2 =
-                plane1 - (pos * s2.local_support_point(pos.rotation.inverse() * -n)).dot(n);
+            let reach2 = plane1 - s2.support_point(&pos, -n).dot(n);
             let reach1 = s1.local_support_point(n).dot(n) - plane2;
-            reach1.max(reach2) > deepest + MISSED_DEPTH
+            reach1.max(reach2) > max_penetration(std::slice::from_ref(m)) + MISSED_DEPTH
         })
     })
 }
