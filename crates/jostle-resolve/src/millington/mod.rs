@@ -5,7 +5,8 @@
 //! One step is a linear pipeline:
 //! 0. integrate gravity into velocities ([`crate::integrate::integrate_velocities`]);
 //! 1. [`prepare`](mod@prepare) every contact once: contact basis, lever arms, closing velocity in contact
-//!    space, desired velocity change (micro-collision rule);
+//!    space (its tangential part with the chord term of turning bodies, see [`prepare()`]),
+//!    desired velocity change (micro-collision rule);
 //! 2. split the contacts into independent islands ([`islands`]);
 //! 3. the **position pass**: per island, worst penetration first, nonlinear (or linear)
 //!    projection ([`position`]), updating the penetration of every contact sharing a body;

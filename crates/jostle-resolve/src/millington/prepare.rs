@@ -1,6 +1,8 @@
 //! Contact preparation: everything the two passes need about a contact, computed once per step
 //! (Cyclone's `calculateInternals`): the contact basis, the lever arms, the closing velocity in
-//! contact space and the desired velocity change of the micro-collision rule.
+//! contact space (its tangential part with a chord term that Cyclone does not have: how far
+//! each body's turn carries its point off the tangent within the step) and the desired
+//! velocity change of the micro-collision rule.
 
 use super::change::NO_BODY;
 use crate::{Contact, STATIC_BODY, SolverBody};
@@ -313,7 +315,29 @@ pub fn prepare(
         }
     };
     let world_velocity = point_velocity(body_a, r[0]) - point_velocity(body_b, r[1]);
-    let velocity = basis.transpose() * world_velocity;
+    let mut velocity = basis.transpose() * world_velocity;
+    // The chord term: the poses advance with the resolved velocities for the whole step, each
+    // centre straight on and each point turned about it, so a point at r on a body turning at
+    // ω moves on average ω × (ω × r)·dt/2 faster than its velocity at the start says. Friction
+    // holds the sliding velocity plus this (A's less B's, on the tangents) at zero, so that a
+    // sticking point follows the other body's point along its arc instead of along the tangent
+    // (a box on a turntable moved outward by r·(ω·dt)²/2 every step). Only against an immovable
+    // body that turns (a kinematic one), as in the soft step
+    // (`soft_step::batch::PointLanes::chord`).
+    let centripetal = |b: &SolverBody, r: Vec3| {
+        if b.rotates() {
+            b.angular_velocity.cross(b.angular_velocity.cross(r))
+        } else {
+            Vec3::ZERO
+        }
+    };
+    let turning = |b: &SolverBody| b.inv_mass == 0.0 && b.angular_velocity != Vec3::ZERO;
+    if turning(body_a) || turning(body_b) {
+        let chord = basis.transpose()
+            * ((centripetal(body_a, r[0]) - centripetal(body_b, r[1])) * (0.5 * dt));
+        velocity.y += chord.y;
+        velocity.z += chord.z;
+    }
     let acc = basis.transpose() * ((body_a.last_acceleration - body_b.last_acceleration) * dt);
     // Cyclone adds the planar part of a·dt to the closing velocity here because it integrates
     // poses with the velocity *before* resolution, so friction must pre-empt the a·dt the next

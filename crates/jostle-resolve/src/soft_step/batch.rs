@@ -112,6 +112,19 @@ pub struct PointLanes<F = F8> {
     /// The relax pass takes friction's velocity from its normal row's with it instead of
     /// computing the relative velocity again.
     pub normal_tangent: [F; 2],
+    /// The chord term of friction along t₁, t₂ (m/s²): how the relative velocity of A's
+    /// point and B's turns within the step, ω_A × (ω_A × r_A) − ω_B × (ω_B × r_B) at the
+    /// step-start velocities. The anchors stay as they were at the start of the step, so
+    /// friction would otherwise hold a sticking point to the other's velocity there all
+    /// step long, and carry it straight along the tangent while the point it sticks to
+    /// turns (a box on a turntable moved outward by r·(ω·Δt)²/2 every step). Friction
+    /// holds the relative velocity plus this times the time into the step at zero
+    /// ([`super::solve::BiasedPass::chord_time`]). Zero unless one of the two bodies is
+    /// immovable and turning (a kinematic body), whose turn is sure to last the step: a
+    /// dynamic body's spin at the start of a step is often what the step's own contacts take
+    /// out (a box's first step under 10⁵ m/s² spun it at 15 rad/s), and a chord term from it
+    /// sent such runs on other courses (benches/RESULTS.md, "Loads on a turntable").
+    pub chord: [F; 2],
     /// Restitution e.
     pub restitution: F,
     /// Normal relative velocity at the start of the step (m/s).
@@ -126,8 +139,8 @@ pub struct PointLanes<F = F8> {
     pub separation: F,
 }
 
-// 212 bytes per contact point: 11 vectors and 20 scalars, each eight lanes wide.
-const _: () = assert!(size_of::<PointLanes>() <= 212 * LANES);
+// 220 bytes per contact point: 11 vectors and 22 scalars, each eight lanes wide.
+const _: () = assert!(size_of::<PointLanes>() <= 220 * LANES);
 
 /// Eight manifolds (one per lane) with disjoint non-static bodies; their points are
 /// `points[first .. first + count]` of the [`Batches`].

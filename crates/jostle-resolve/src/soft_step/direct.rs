@@ -1128,6 +1128,10 @@ impl Solver {
             by_point,
         } = island;
         let relax = matches!(pass, RowPass::Relax { .. });
+        let chord_time = match pass {
+            RowPass::Biased(pass) => pass.chord_time,
+            RowPass::Relax { chord_time, .. } => chord_time,
+        };
         self.residual.clear();
         self.residual.resize(rows.len(), RowState::default());
         self.impulse.clear();
@@ -1176,7 +1180,7 @@ impl Solver {
                     let impulse = p.tangent_impulse[kind as usize - 1][l];
                     let role = self.role[normal];
                     let state = RowState {
-                        r: -row.velocity(states),
+                        r: -(row.velocity(states) + p.chord[kind as usize - 1][l] * chord_time),
                         compliance: self.residual[normal].compliance.max(row.floor as f32),
                     };
                     (state, impulse, role)

@@ -4,9 +4,11 @@
 //! One step of length dt with n substeps of h = dt/n is a linear pipeline:
 //! 1. [`prepare`](prepare::prepare_point) every contact once on the step-start poses:
 //!    anchors, basis, effective masses, the angular response to unit impulses, softness
-//!    (static or dynamic stiffness, from [`Softness::new`] at h), the approach velocity, and
-//!    the previous step's impulse as the warm start; contacts with a gap above the speculative
-//!    margin, or between two immovable bodies, take no part. The contacts are packed eight
+//!    (static or dynamic stiffness, from [`Softness::new`] at h), the approach velocity, the
+//!    chord term with which friction follows a turning kinematic body's point
+//!    ([`batch::PointLanes::chord`]), and the previous step's impulse as the warm start;
+//!    contacts with a gap above the speculative margin, or between two immovable bodies, take
+//!    no part. The contacts are packed eight
 //!    manifolds to a batch of independent bodies ([`batch`]) and every kernel below works on
 //!    eight manifolds at once ([`lanes`]). Small islands where a heavy body rests on light
 //!    ones, and chains of bodies (columns), are picked out and their springs sized by their
@@ -967,11 +969,14 @@ impl Substeps<'_> {
     /// The substeps, stage by stage on `crew`.
     fn run(&self, crew: &impl Crew, timing: &Timing) {
         for substep in 0..self.substeps {
+            // The middle of this substep, from the start of the step.
+            let chord_time = (substep as f32 + 0.5) / self.inv_h;
             // After the first substep the relax pass has stored every point's separation at
             // the poses the biased pass starts from.
             let pass = solve::BiasedPass {
                 stored_separation: substep > 0 && self.relax_iterations > 0 && !self.pass.rigid,
                 after_warm_start: substep == 0,
+                chord_time,
                 ..self.pass
             };
             timing.time(Timing::INTEGRATE, || {
@@ -1046,12 +1051,21 @@ impl Substeps<'_> {
                             p,
                             base,
                             self.states,
-                            self.inv_h,
-                            self.sweeps,
-                            self.block_relax,
+                            solve::RelaxPass {
+                                inv_h: self.inv_h,
+                                chord_time,
+                                sweeps: self.sweeps,
+                                block: self.block_relax,
+                            },
                         );
                     });
-                    self.direct_correct(crew, solve::RowPass::Relax { inv_h: self.inv_h });
+                    self.direct_correct(
+                        crew,
+                        solve::RowPass::Relax {
+                            inv_h: self.inv_h,
+                            chord_time,
+                        },
+                    );
                 }
             });
         }
@@ -1251,6 +1265,8 @@ impl Resolver for SoftStepResolver {
             rate: self.settings.push_out_rate * inv_h,
             stored_separation: false,
             after_warm_start: false,
+            // Each substep's own (`Substeps::run`).
+            chord_time: 0.0,
         };
         let substeps_start = Stopwatch::start();
         let direct_live = !self.direct.is_empty();

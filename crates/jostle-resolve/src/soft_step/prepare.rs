@@ -208,6 +208,16 @@ pub fn prepare_point<F: Lane>(
     let warm = stored * F::splat(params.warm_scale);
     let has_friction = friction.cmpgt(F::ZERO);
     let dv = a.velocity_at(r_a) - b.velocity_at(r_b);
+    // The chord term ([`PointLanes::chord`]): each point's centripetal acceleration about
+    // its body's centre, A's less B's, on the tangents only (the normal rows see the
+    // separation itself); only where one of the bodies is immovable and turning.
+    let (wa, wb) = (a.angular_velocity, b.angular_velocity);
+    let prescribed = (a.inv_mass.cmpeq(F::ZERO) & wa.dot(wa).cmpgt(F::ZERO))
+        | (b.inv_mass.cmpeq(F::ZERO) & wb.dot(wb).cmpgt(F::ZERO));
+    let chord = zero_unless(
+        prescribed,
+        wa.cross(wa.cross(r_a)) - wb.cross(wb.cross(r_b)),
+    );
     // The preload acts in proportion to the overlap up to its full value, reached at the
     // target overlap: slope p / target. The spring is then 1 + slope times stiffer there, and
     // the load λ it carries rides on it like a mass of λ/(|g|·h); its damping ratio falls as
@@ -246,6 +256,7 @@ pub fn prepare_point<F: Lane>(
             F::select(has_friction, warm.z, F::ZERO),
         ],
         normal_tangent,
+        chord: [chord.dot(t1), chord.dot(t2)],
         restitution: F::from_array(restitution),
         relative_velocity: dv.dot(n),
         preload,

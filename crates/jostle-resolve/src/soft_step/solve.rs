@@ -494,7 +494,8 @@ wide_kernel! {
 const DISK_PROJECTION_ITERATIONS: usize = 2;
 
 /// Friction for one point of eight lanes: both tangents at once with the 2×2 effective mass
-/// K (the unconstrained impulse λ* = λ_old − K⁻¹·v_t stops the sliding dead), accumulated and
+/// K (the unconstrained impulse λ* = λ_old − K⁻¹·v_t stops the sliding dead, v_t the relative
+/// tangential velocity plus [`PointLanes::chord`]), accumulated and
 /// kept in the disk |λ| ≤ r = μ·λ_n.
 ///
 /// Over the limit, the accumulated impulse is the point of the disk closest to λ* in K's
@@ -506,17 +507,23 @@ const DISK_PROJECTION_ITERATIONS: usize = 2;
 /// the rotational terms make K anisotropic (at a box's corners) it turns the friction away from
 /// −v_t, and a box sliding on the ground felt only 0.936·μ.
 #[inline(always)]
-fn solve_friction<F: Lane, L: LinearResponse<F>>(pair: &mut Pair<F, L>, p: &mut PointLanes<F>) {
+fn solve_friction<F: Lane, L: LinearResponse<F>>(
+    pair: &mut Pair<F, L>,
+    p: &mut PointLanes<F>,
+    chord_time: F,
+) {
     let dv = pair.relative_velocity(p);
-    let [d1, d2] = friction_change(p, dv.dot(p.tangent1), dv.dot(p.tangent2));
+    let [d1, d2] = friction_change(p, dv.dot(p.tangent1), dv.dot(p.tangent2), chord_time);
     pair.apply_tangent(p, d1, d2);
 }
 
 /// The friction row of [`solve_friction`] at tangential velocities `vt1`, `vt2`: updates
 /// the point's accumulated tangent impulse and returns its change, to be applied.
 #[inline(always)]
-fn friction_change<F: Lane>(p: &mut PointLanes<F>, vt1: F, vt2: F) -> [F; 2] {
+fn friction_change<F: Lane>(p: &mut PointLanes<F>, vt1: F, vt2: F, chord_time: F) -> [F; 2] {
     let [k0, k1, k2] = p.tangent_mass;
+    let vt1 = vt1 + p.chord[0] * chord_time;
+    let vt2 = vt2 + p.chord[1] * chord_time;
     let [old1, old2] = p.tangent_impulse;
     let mut new1 = old1 - (k0 * vt1 + k1 * vt2);
     let mut new2 = old2 - (k1 * vt1 + k2 * vt2);
@@ -670,6 +677,8 @@ pub enum RowPass {
     Relax {
         /// 1/substep (1/s).
         inv_h: f32,
+        /// [`BiasedPass::chord_time`].
+        chord_time: f32,
     },
 }
 
@@ -705,7 +714,7 @@ pub fn row_residuals(
             let row = biased_row(&pair, p, s, &BiasedConsts::new(&pass));
             (row.delta, row.mass, row.compliance)
         }
-        RowPass::Relax { inv_h } => {
+        RowPass::Relax { inv_h, .. } => {
             // The rigid row, with its spring's compliance all the same: the rows of a face
             // span fewer motions than it has points, and a speculative row's gap rule need
             // not agree with any rigid motion at all; the compliance shares the impulse among
@@ -767,9 +776,11 @@ fn relax_batch<F: Lane, L: LinearResponse<F>>(
     points: &mut [PointLanes<F>],
     states: &[Shared<BodyState>],
     inv_h: f32,
+    chord_time: f32,
     sweeps: u32,
 ) {
     let inv_h = F::splat(inv_h);
+    let chord_time = F::splat(chord_time);
     // The separations at the poses this substep reached: kept for the next substep's biased
     // pass, which starts from the same poses (`BiasedPass::stored_separation`).
     store_separations(m, points, states);
@@ -782,13 +793,13 @@ fn relax_batch<F: Lane, L: LinearResponse<F>>(
         }
         if m.friction {
             for p in points.iter_mut() {
-                solve_friction(pair, p);
+                solve_friction(pair, p, chord_time);
             }
         }
         return;
     }
     for p in points.iter_mut() {
-        relax_point(m, pair, p, inv_h);
+        relax_point(m, pair, p, inv_h, chord_time);
     }
 }
 
@@ -910,12 +921,13 @@ fn relax_block<F: Lane, L: LinearResponse<F>>(
     points: &mut [PointLanes<F>],
     states: &[Shared<BodyState>],
     inv_h: F,
+    chord_time: F,
 ) {
     store_separations(m, points, states);
     if m.side {
         // Near horizontal: point by point, as a lane whose block solution pulls.
         for p in points.iter_mut() {
-            relax_point(m, pair, p, inv_h);
+            relax_point(m, pair, p, inv_h, chord_time);
         }
         return;
     }
@@ -978,7 +990,7 @@ fn relax_block<F: Lane, L: LinearResponse<F>>(
             accumulate_normal(pair, p, F::select(pulls, gs, F::ZERO));
         }
         if m.friction {
-            solve_friction(pair, p);
+            solve_friction(pair, p, chord_time);
         }
     }
 }
@@ -993,6 +1005,7 @@ fn relax_point<F: Lane, L: LinearResponse<F>>(
     pair: &mut Pair<F, L>,
     p: &mut PointLanes<F>,
     inv_h: F,
+    chord_time: F,
 ) {
     if !m.friction {
         solve_normal_rigid(pair, p, p.separation, inv_h);
@@ -1004,7 +1017,7 @@ fn relax_point<F: Lane, L: LinearResponse<F>>(
     let [c1, c2] = p.normal_tangent;
     let vt1 = dv.dot(p.tangent1) + dn * c1;
     let vt2 = dv.dot(p.tangent2) + dn * c2;
-    let [d1, d2] = friction_change(p, vt1, vt2);
+    let [d1, d2] = friction_change(p, vt1, vt2, chord_time);
     let impulse = p.normal * dn + p.tangent1 * d1 + p.tangent2 * d2;
     pair.a.linear += pair.inv_mass_a.times(impulse);
     pair.a.angular += p.ang_a_normal * dn + p.ang_a_tangent1 * d1 + p.ang_a_tangent2 * d2;
@@ -1055,6 +1068,10 @@ pub struct BiasedPass {
     /// point's carried friction impulse is kept within the cone of its normal impulse as the
     /// pass leaves it ([`keep_in_cone`]).
     pub after_warm_start: bool,
+    /// Time (s) from the start of the step to the middle of this substep, (k + ½)·h: friction
+    /// holds the relative velocity plus [`PointLanes::chord`] times this at zero, so that a
+    /// sticking point's velocity turns through the step as the point it sticks to does.
+    pub chord_time: f32,
 }
 
 /// The biased pass over one batch with rigid contacts
@@ -1092,7 +1109,7 @@ fn solve_batch_rigid<F: Lane, L: LinearResponse<F>>(
     }
     if pass.friction && m.friction {
         for p in points.iter_mut() {
-            solve_friction(pair, p);
+            solve_friction(pair, p, F::splat(pass.chord_time));
         }
     }
     let mut any = *live;
@@ -1287,7 +1304,7 @@ fn solve_batch_split<F: Lane, L: LinearResponse<F>>(
         }
 
         if m.friction && friction {
-            solve_friction(pair, p);
+            solve_friction(pair, p, F::splat(pass.chord_time));
         } else if m.friction && pass.after_warm_start {
             keep_in_cone(pair, p);
         }
@@ -1394,16 +1411,21 @@ fn relax_impl<F: Lane>(
     points: &mut [PointLanes<F>],
     base: u32,
     states: &[Shared<BodyState>],
-    inv_h: f32,
-    sweeps: u32,
-    block: bool,
+    pass: RelaxPass,
 ) {
+    let RelaxPass {
+        inv_h,
+        chord_time,
+        sweeps,
+        block,
+    } = pass;
     let mut rest = manifolds;
     if block {
         // Block relax (`SoftStepSettings::block_relax`). (Two block batches interleaved, as
         // below, measured no faster here.) Two side batches, solved point by point, are
         // interleaved as the plain relax's are.
         let inv_h_lanes = F::splat(inv_h);
+        let chord_lanes = F::splat(chord_time);
         let mut i = 0;
         while i < manifolds.len() {
             let m0 = &manifolds[i];
@@ -1413,7 +1435,7 @@ fn relax_impl<F: Lane>(
                 && !m0.locked
                 && !m1.locked
             {
-                relax_two(m0, m1, points, base, states, inv_h_lanes);
+                relax_two(m0, m1, points, base, states, inv_h_lanes, chord_lanes);
                 i += 2;
                 continue;
             }
@@ -1423,7 +1445,7 @@ fn relax_impl<F: Lane>(
                 base,
                 states,
                 |m, pair, points, states| {
-                    relax_block(m, pair, points, states, inv_h_lanes);
+                    relax_block(m, pair, points, states, inv_h_lanes, chord_lanes);
                 }
             );
             i += 1;
@@ -1435,6 +1457,7 @@ fn relax_impl<F: Lane>(
         // resolve stage on one thread: 0.399 → 0.379 ms; the same interleave in the biased
         // pass gained nothing).
         let inv_h_lanes = F::splat(inv_h);
+        let chord_lanes = F::splat(chord_time);
         let mut twos = manifolds.chunks_exact(2);
         for two in &mut twos {
             let (m0, m1) = (&two[0], &two[1]);
@@ -1446,17 +1469,17 @@ fn relax_impl<F: Lane>(
                     base,
                     states,
                     |m, pair, points, states| {
-                        relax_batch(m, pair, points, states, inv_h, sweeps);
+                        relax_batch(m, pair, points, states, inv_h, chord_time, sweeps);
                     }
                 );
                 continue;
             }
-            relax_two(m0, m1, points, base, states, inv_h_lanes);
+            relax_two(m0, m1, points, base, states, inv_h_lanes, chord_lanes);
         }
         rest = twos.remainder();
     }
     for_each_batch!(rest, points, base, states, |m, pair, points, states| {
-        relax_batch(m, pair, points, states, inv_h, sweeps);
+        relax_batch(m, pair, points, states, inv_h, chord_time, sweeps);
     });
 }
 
@@ -1473,6 +1496,7 @@ fn relax_two<F: Lane>(
     base: u32,
     states: &[Shared<BodyState>],
     inv_h: F,
+    chord_time: F,
 ) {
     let (p0, p1) = two_batches(points, base, m0, m1);
     let mut pair0 = Pair::load_plain(m0, states);
@@ -1481,10 +1505,10 @@ fn relax_two<F: Lane>(
     store_separations(m1, p1, states);
     for k in 0..p0.len().max(p1.len()) {
         if let Some(p) = p0.get_mut(k) {
-            relax_point(m0, &mut pair0, p, inv_h);
+            relax_point(m0, &mut pair0, p, inv_h, chord_time);
         }
         if let Some(p) = p1.get_mut(k) {
-            relax_point(m1, &mut pair1, p, inv_h);
+            relax_point(m1, &mut pair1, p, inv_h, chord_time);
         }
     }
     pair0.store(m0, states);
@@ -1569,27 +1593,34 @@ fn two_batches<'a, F>(
     (&mut head[f0..f0 + c0], &mut tail[..c1])
 }
 
+/// The parameters of one relax pass ([`relax`]).
+#[derive(Clone, Copy, Debug)]
+pub struct RelaxPass {
+    /// 1/substep (1/s).
+    pub inv_h: f32,
+    /// [`BiasedPass::chord_time`].
+    pub chord_time: f32,
+    /// Sweeps over each manifold's normal rows before its friction (more than 1 with rigid
+    /// contacts only).
+    pub sweeps: u32,
+    /// Each manifold's normal rows solved together (`relax_block`, after
+    /// [`factor_blocks`]; [`super::SoftStepSettings::block_relax`]).
+    pub block: bool,
+}
+
 /// One relax pass: rigid, without bias, so the velocity the soft constraints' bleed let
 /// through is removed again once the positions moved (speculative contacts keep their gap
-/// rule); `sweeps` > 1 sweeps each manifold's normal rows that often before its friction
-/// (rigid contacts); with `block`, each manifold's normal rows are solved together
-/// (`relax_block`, after [`factor_blocks`]).
-pub fn relax(
-    batches: &mut Batches,
-    states: &mut [BodyState],
-    inv_h: f32,
-    sweeps: u32,
-    block: bool,
-) {
+/// rule); [`RelaxPass::sweeps`] > 1 sweeps each manifold's normal rows that often before its
+/// friction (rigid contacts); with [`RelaxPass::block`], each manifold's normal rows are
+/// solved together (`relax_block`, after [`factor_blocks`]).
+pub fn relax(batches: &mut Batches, states: &mut [BodyState], pass: RelaxPass) {
     let states = share(states);
-    by_group(batches, |m, p, base| {
-        relax_range(m, p, base, states, inv_h, sweeps, block)
-    });
+    by_group(batches, |m, p, base| relax_range(m, p, base, states, pass));
 }
 
 wide_kernel! {
     /// [`relax`] over some batches of one group ([`Batches::groups`]).
-    pub(crate) fn relax_range(inv_h: f32, sweeps: u32, block: bool) = relax_impl;
+    pub(crate) fn relax_range(pass: RelaxPass) = relax_impl;
 }
 
 /// Runs `f(manifolds, points, base)` on each group of batches ([`Batches::groups`]) in
@@ -2052,6 +2083,7 @@ mod tests {
             rate: 0.2 * 4.0 / DT,
             stored_separation: false,
             after_warm_start: false,
+            chord_time: 1.5 * DT / 4.0,
         };
         // Rigid contacts: other kernels, several sweeps, friction in the biased pass.
         const RIGID: BiasedPass = BiasedPass {
@@ -2084,6 +2116,12 @@ mod tests {
         }
         assert!(batches.contacts > 1000);
         let inv_h = 4.0 / DT;
+        let relax_pass = RelaxPass {
+            inv_h,
+            chord_time: pass.chord_time,
+            sweeps: pass.sweeps,
+            block,
+        };
 
         let (mut narrow_batches, mut narrow_states) = (batches.clone(), states.clone());
         let Batches {
@@ -2101,7 +2139,7 @@ mod tests {
         );
         let narrow_shared = share(&mut narrow_states);
         by_group(&mut narrow_batches, |m, p, base| {
-            relax_impl::<F8>(m, p, base, narrow_shared, inv_h, pass.sweeps, block)
+            relax_impl::<F8>(m, p, base, narrow_shared, relax_pass)
         });
         // The pile starts overlapping, so the split push-out did work too.
         assert!(narrow_pseudo.iter().flatten().any(|&x| x != 0.0));
@@ -2122,7 +2160,7 @@ mod tests {
             let mut pseudo = vec![[0.0; 8]; states.len()];
             warm_start(&mut batches, &mut states);
             solve(&mut batches, &mut states, &mut pseudo, pass);
-            relax(&mut batches, &mut states, inv_h, pass.sweeps, block);
+            relax(&mut batches, &mut states, relax_pass);
             let mut wide = bits(&states, &batches);
             wide.extend(pseudo.iter().flatten().map(|x| x.to_bits()));
             assert_eq!(wide.len(), narrow.len());
