@@ -120,6 +120,9 @@ pub(crate) struct Gyro<'a> {
     /// The f64 inverse of each body's `inertia`, taken once for the step; `None` where the
     /// inertia is zero or cannot be inverted (the body then turns by ω alone).
     pub(crate) inverse: &'a [Option<Inverse64>],
+    /// Each body's `inertia` as an axisymmetric one where it is
+    /// ([`super::gyroscopic::Axisymmetric::of`]): without contact rows it turns exactly.
+    pub(crate) axisymmetric: &'a [Option<super::gyroscopic::Axisymmetric>],
     /// The step-start world inverse inertia each body's contact rows use, zero for a body
     /// without contact rows.
     pub(crate) rows_inverse: &'a [Mat3],
@@ -149,6 +152,7 @@ pub(crate) fn integrate_positions(
     debug_assert_eq!(states.len(), pseudo.len());
     debug_assert!(gyro.is_none_or(|g| g.inertia.len() == states.len()
         && g.inverse.len() == states.len()
+        && g.axisymmetric.len() == states.len()
         && g.rows_inverse.len() == states.len()));
     for (k, (s, p)) in states.iter_mut().zip(pseudo.iter_mut()).enumerate() {
         if s.flags & FREE != 0 {
@@ -167,7 +171,15 @@ pub(crate) fn integrate_positions(
                 .and_then(|g| {
                     let inverse = g.inverse[k].as_ref()?;
                     let (i0, rows) = (g.inertia[k], g.rows_inverse[k]);
-                    turn_inverted(i0, inverse, rows, s.delta_rotation, s.angular_velocity, h)
+                    turn_inverted(
+                        i0,
+                        inverse,
+                        g.axisymmetric[k].as_ref(),
+                        rows,
+                        s.delta_rotation,
+                        s.angular_velocity,
+                        h,
+                    )
                 });
             let moved = match carried {
                 Some((after, omega)) => {

@@ -170,6 +170,9 @@ pub struct SoftStepResolver {
     /// The f64 inverse of each body's `inertia` (`None` for a zero one), taken once a step for
     /// its turns (`gyroscopic::turn_inverted`).
     inertia_inverse: Vec<Option<Inverse64>>,
+    /// Each body's `inertia` as an axisymmetric one where it is (`gyroscopic::Axisymmetric`),
+    /// taken with its inverse: such a body turns exactly while it has no contact rows.
+    axisymmetric: Vec<Option<gyroscopic::Axisymmetric>>,
     /// With the gyroscopic term: each body's step-start world inverse inertia if some contact
     /// of the step involves it, else zero (`gyroscopic::turn_against`).
     rows_inverse: Vec<Mat3>,
@@ -378,6 +381,12 @@ impl SoftStepResolver {
                 .iter()
                 .map(|&i| (i != Mat3::ZERO).then(|| Inverse64::of(i)).flatten()),
         );
+        self.axisymmetric.clear();
+        self.axisymmetric.extend(self.inertia.iter().map(|&i| {
+            (i != Mat3::ZERO)
+                .then(|| gyroscopic::Axisymmetric::of(i))
+                .flatten()
+        }));
     }
 
     /// Marks [`body_state::FREE`] the bodies in no batch, not turning and without forces:
@@ -945,6 +954,8 @@ struct Substeps<'a> {
     inertia: &'a [Mat3],
     /// [`SoftStepResolver::inertia_inverse`].
     inertia_inverse: &'a [Option<Inverse64>],
+    /// [`SoftStepResolver::axisymmetric`].
+    axisymmetric: &'a [Option<gyroscopic::Axisymmetric>],
     /// [`SoftStepResolver::rows_inverse`].
     rows_inverse: &'a [Mat3],
     gyroscopic: bool,
@@ -1037,6 +1048,7 @@ impl Substeps<'_> {
                     let gyro = self.gyroscopic.then(|| integrate::Gyro {
                         inertia: &self.inertia[range.clone()],
                         inverse: &self.inertia_inverse[range.clone()],
+                        axisymmetric: &self.axisymmetric[range.clone()],
                         rows_inverse: &self.rows_inverse[range.clone()],
                     });
                     integrate::integrate_positions(states, pseudo, gyro, self.h);
@@ -1288,6 +1300,7 @@ impl Resolver for SoftStepResolver {
                 pushes: &self.pushes,
                 inertia: &self.inertia,
                 inertia_inverse: &self.inertia_inverse,
+                axisymmetric: &self.axisymmetric,
                 rows_inverse: &self.rows_inverse,
                 gyroscopic: self.settings.gyroscopic,
                 direct: share_one(&mut self.direct),
