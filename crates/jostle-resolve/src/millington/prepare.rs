@@ -321,20 +321,18 @@ pub fn prepare(
     // ω moves on average ω × (ω × r)·dt/2 faster than its velocity at the start says. Friction
     // holds the sliding velocity plus this (A's less B's, on the tangents) at zero, so that a
     // sticking point follows the other body's point along its arc instead of along the tangent
-    // (a box on a turntable moved outward by r·(ω·dt)²/2 every step). Only against an immovable
-    // body that turns (a kinematic one), as in the soft step
-    // (`soft_step::batch::PointLanes::chord`).
-    let centripetal = |b: &SolverBody, r: Vec3| {
-        if b.rotates() {
-            b.angular_velocity.cross(b.angular_velocity.cross(r))
-        } else {
-            Vec3::ZERO
-        }
+    // (a box on a turntable moved outward by r·(ω·dt)²/2 every step). Both points are taken
+    // at the turn of the immovable body of the pair (a kinematic one), as a sticking point
+    // turns with it, and only there: as in the soft step (`soft_step::batch::PointLanes::chord`).
+    let turn = if body_a.inv_mass == 0.0 {
+        body_a.angular_velocity
+    } else if body_b.inv_mass == 0.0 {
+        body_b.angular_velocity
+    } else {
+        Vec3::ZERO
     };
-    let turning = |b: &SolverBody| b.inv_mass == 0.0 && b.angular_velocity != Vec3::ZERO;
-    if turning(body_a) || turning(body_b) {
-        let chord = basis.transpose()
-            * ((centripetal(body_a, r[0]) - centripetal(body_b, r[1])) * (0.5 * dt));
+    if turn != Vec3::ZERO {
+        let chord = basis.transpose() * (turn.cross(turn.cross(r[0] - r[1])) * (0.5 * dt));
         velocity.y += chord.y;
         velocity.z += chord.z;
     }

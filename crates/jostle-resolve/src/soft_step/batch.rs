@@ -113,17 +113,19 @@ pub struct PointLanes<F = F8> {
     /// computing the relative velocity again.
     pub normal_tangent: [F; 2],
     /// The chord term of friction along t₁, t₂ (m/s²): how the relative velocity of A's
-    /// point and B's turns within the step, ω_A × (ω_A × r_A) − ω_B × (ω_B × r_B) at the
-    /// step-start velocities. The anchors stay as they were at the start of the step, so
+    /// point and B's turns within the step while they stick, ω × (ω × (r_A − r_B)) for the
+    /// turn ω of the immovable body of the pair (both points turn with it). The anchors stay as they were at the start of the step, so
     /// friction would otherwise hold a sticking point to the other's velocity there all
     /// step long, and carry it straight along the tangent while the point it sticks to
     /// turns (a box on a turntable moved outward by r·(ω·Δt)²/2 every step). Friction
     /// holds the relative velocity plus this times the time into the step at zero
-    /// ([`super::solve::BiasedPass::chord_time`]). Zero unless one of the two bodies is
-    /// immovable and turning (a kinematic body), whose turn is sure to last the step: a
-    /// dynamic body's spin at the start of a step is often what the step's own contacts take
-    /// out (a box's first step under 10⁵ m/s² spun it at 15 rad/s), and a chord term from it
-    /// sent such runs on other courses (benches/RESULTS.md, "Loads on a turntable").
+    /// ([`super::solve::BiasedPass::chord_time`]). Zero unless one body is immovable and
+    /// turning (a kinematic one), whose turn is sure to last the step: a dynamic body's spin
+    /// at the start of a step is often what the step's own contacts take out (a box's first
+    /// step under 10⁵ m/s² spun it at 15 rad/s), and a chord term from it sent such runs on
+    /// other courses (benches/RESULTS.md, "Loads on a turntable"). Taking the dynamic body's
+    /// own spin for its point, as a first form did, gave a body landing on a turntable a
+    /// target from a spin the landing takes out.
     pub chord: [F; 2],
     /// Restitution e.
     pub restitution: F,

@@ -208,16 +208,15 @@ pub fn prepare_point<F: Lane>(
     let warm = stored * F::splat(params.warm_scale);
     let has_friction = friction.cmpgt(F::ZERO);
     let dv = a.velocity_at(r_a) - b.velocity_at(r_b);
-    // The chord term ([`PointLanes::chord`]): each point's centripetal acceleration about
-    // its body's centre, A's less B's, on the tangents only (the normal rows see the
-    // separation itself); only where one of the bodies is immovable and turning.
-    let (wa, wb) = (a.angular_velocity, b.angular_velocity);
-    let prescribed = (a.inv_mass.cmpeq(F::ZERO) & wa.dot(wa).cmpgt(F::ZERO))
-        | (b.inv_mass.cmpeq(F::ZERO) & wb.dot(wb).cmpgt(F::ZERO));
-    let chord = zero_unless(
-        prescribed,
-        wa.cross(wa.cross(r_a)) - wb.cross(wb.cross(r_b)),
+    // The chord term ([`PointLanes::chord`]) at the turn of the immovable body of the pair (a
+    // turning kinematic one; a fixed one has none, and two immovable bodies take no part), on
+    // the tangents only (the normal rows see the separation itself).
+    let turn = select(
+        a.inv_mass.cmpeq(F::ZERO),
+        a.angular_velocity,
+        zero_unless(b.inv_mass.cmpeq(F::ZERO), b.angular_velocity),
     );
+    let chord = turn.cross(turn.cross(r_a - r_b));
     // The preload acts in proportion to the overlap up to its full value, reached at the
     // target overlap: slope p / target. The spring is then 1 + slope times stiffer there, and
     // the load λ it carries rides on it like a mass of λ/(|g|·h); its damping ratio falls as
@@ -264,6 +263,16 @@ pub fn prepare_point<F: Lane>(
         // Computed by the first pass that needs it.
         separation: F::ZERO,
     };
+}
+
+/// `t` in the lanes of `mask`, `f` in the others.
+#[inline(always)]
+fn select<F: Lane>(mask: F::Mask, t: V3x8<F>, f: V3x8<F>) -> V3x8<F> {
+    V3x8 {
+        x: F::select(mask, t.x, f.x),
+        y: F::select(mask, t.y, f.y),
+        z: F::select(mask, t.z, f.z),
+    }
 }
 
 /// `v` in the lanes of `mask`, zero in the others.
