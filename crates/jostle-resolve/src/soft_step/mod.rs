@@ -170,8 +170,8 @@ pub struct SoftStepResolver {
     /// The f64 inverse of each body's `inertia` (`None` for a zero one), taken once a step for
     /// its turns (`gyroscopic::turn_inverted`).
     inertia_inverse: Vec<Option<Inverse64>>,
-    /// Each body's `inertia` as an axisymmetric one where it is (`gyroscopic::Axisymmetric`),
-    /// taken with its inverse: such a body turns exactly while it has no contact rows.
+    /// Each body's `inertia` as an axisymmetric one where it is (`gyroscopic::Axisymmetric`)
+    /// and the body has no contact rows this step: such a body turns exactly.
     axisymmetric: Vec<Option<gyroscopic::Axisymmetric>>,
     /// With the gyroscopic term: each body's step-start world inverse inertia if some contact
     /// of the step involves it, else zero (`gyroscopic::turn_against`).
@@ -381,12 +381,6 @@ impl SoftStepResolver {
                 .iter()
                 .map(|&i| (i != Mat3::ZERO).then(|| Inverse64::of(i)).flatten()),
         );
-        self.axisymmetric.clear();
-        self.axisymmetric.extend(self.inertia.iter().map(|&i| {
-            (i != Mat3::ZERO)
-                .then(|| gyroscopic::Axisymmetric::of(i))
-                .flatten()
-        }));
     }
 
     /// Marks [`body_state::FREE`] the bodies in no batch, not turning and without forces:
@@ -636,6 +630,20 @@ impl SoftStepResolver {
         };
         self.batches
             .arrange_with(contacts, bodies, s.speculative_margin, &params, mark_rows);
+        // Only a body without contact rows turns exactly as an axisymmetric one, so only such
+        // a body's inertia is looked at (both lists are empty without the gyroscopic term).
+        debug_assert_eq!(self.inertia.len(), self.rows_inverse.len());
+        self.axisymmetric.clear();
+        self.axisymmetric.extend(
+            self.inertia
+                .iter()
+                .zip(&self.rows_inverse)
+                .map(|(&i, &rows)| {
+                    (i != Mat3::ZERO && rows == Mat3::ZERO)
+                        .then(|| gyroscopic::Axisymmetric::of(i))
+                        .flatten()
+                }),
+        );
         params
     }
 

@@ -278,11 +278,7 @@ fn select<F: Lane>(mask: F::Mask, t: V3x8<F>, f: V3x8<F>) -> V3x8<F> {
 /// `v` in the lanes of `mask`, zero in the others.
 #[inline(always)]
 fn zero_unless<F: Lane>(mask: F::Mask, v: V3x8<F>) -> V3x8<F> {
-    V3x8 {
-        x: F::select(mask, v.x, F::ZERO),
-        y: F::select(mask, v.y, F::ZERO),
-        z: F::select(mask, v.z, F::ZERO),
-    }
+    select(mask, v, V3x8::ZERO)
 }
 
 /// Prepares every point of the packed batches: for each batch, its bodies are gathered once
