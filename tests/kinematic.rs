@@ -486,15 +486,17 @@ fn scene_kinematic_fields_are_checked() {
 /// box went along the tangent while the table's point turned under it: r·(ω·Δt)²/2 outward
 /// every step (a box at 1 m on a table turning every 4 s reached 1.33 m in 10 s in the soft
 /// step, 1.24 m in the Millington resolver). Friction in both resolvers, against a turning
-/// kinematic body, now holds the point to the other's chord through the step. Over box sizes, radii, turn rates (the centripetal
-/// acceleration a fraction of μ·g), friction and time steps, at each resolver's defaults:
-/// the box is carried round (at 10 s its speed is the table's there to 1%, and at 2 s it is
-/// within 5% of its starting radius, where the spin-up left it), and from 2 s (after the box
-/// has caught up with the table) to 10 s the radius changes by less than 1 mm, and in the
-/// Millington resolver by less than that plus its velocity epsilon
-/// times the 8 s: its velocity pass leaves a contact sliding slower than the epsilon alone,
-/// and the box creeps outward at about that speed (ε 10⁻⁴ m/s: 2.6 mm from 2 s to 20 s; ε
-/// 10⁻⁵: 0.7 mm; ε 10⁻⁶: 0.2 mm).
+/// kinematic body, now holds the point to the other's chord through the step. Over box sizes,
+/// radii, turn rates (the centripetal acceleration a fraction of μ·g), friction and time
+/// steps, at each resolver's defaults, on tables turning about their own centre: the box is
+/// carried round (at 10 s its speed is the table's there to 1%, and at 2 s it is within 5% of
+/// its starting radius, where the spin-up left it), and from 2 s (after the box has caught up
+/// with the table) to 10 s the radius changes by less than 1 mm, and in the Millington
+/// resolver by less than that plus its velocity epsilon times the 8 s: its velocity pass
+/// leaves a contact sliding slower than the epsilon alone, and the box creeps outward at about
+/// that speed (ε 10⁻⁴ m/s: 2.6 mm from 2 s to 20 s; ε 10⁻⁵: 0.7 mm; ε 10⁻⁶: 0.2 mm). (A table
+/// turning about an axis off its centre still drifts in the soft step: benches/RESULTS.md,
+/// "Loads on a turntable".)
 #[test]
 fn loads_on_a_turntable_keep_their_radius() {
     use jostle::KinematicPath;

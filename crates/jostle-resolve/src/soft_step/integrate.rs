@@ -120,8 +120,9 @@ pub(crate) struct Gyro<'a> {
     /// The f64 inverse of each body's `inertia`, taken once for the step; `None` where the
     /// inertia is zero or cannot be inverted (the body then turns by ω alone).
     pub(crate) inverse: &'a [Option<Inverse64>],
-    /// Each body's `inertia` as an axisymmetric one where it is
-    /// ([`super::gyroscopic::Axisymmetric::of`]): without contact rows it turns exactly.
+    /// Each body's `inertia` as an axisymmetric one ([`super::gyroscopic::Axisymmetric::of`])
+    /// where it is and the body has no contact rows, `None` otherwise: such a body turns
+    /// exactly.
     pub(crate) axisymmetric: &'a [Option<super::gyroscopic::Axisymmetric>],
     /// The step-start world inverse inertia each body's contact rows use, zero for a body
     /// without contact rows.
