@@ -241,6 +241,8 @@ pub struct Batches {
     /// `manifolds`, `sources` and `groups` lengths that the last full packing left, or
     /// `None` before the first one: a layout is reused only if they are unchanged.
     layout_lengths: Option<[usize; 3]>,
+    /// Counts the layouts made afresh ([`Batches::generation`]).
+    generation: u64,
 }
 
 /// A contact that takes part in the step, as [`Batches::pack`]'s layout sees it: everything
@@ -401,6 +403,12 @@ impl Batches {
         }
     }
 
+    /// How many times the batches have been laid out afresh: while it stays the same, every
+    /// batch writes the same bodies as before.
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+
     /// Makes the next [`Batches::pack`] lay the batches out afresh.
     pub fn forget_layout(&mut self) {
         self.layout_lengths = None;
@@ -410,6 +418,7 @@ impl Batches {
     /// `manifolds` (their bodies and points, not yet prepared), `sources`, `groups`,
     /// `colours` and `overflow`. `bodies`: how many bodies there are.
     fn lay_out(&mut self, bodies: usize) {
+        self.generation = self.generation.wrapping_add(1);
         self.manifolds.clear();
         // `points` is resized below, not cleared: every point is overwritten by the
         // preparation, so only a growth needs filling (a step's 1.5 kB per point is otherwise

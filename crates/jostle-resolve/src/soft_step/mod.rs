@@ -205,8 +205,31 @@ pub struct SoftStepResolver {
     /// The threads of the substeps ([`team`]) and the stages they run.
     team: Team,
     plan: Vec<team::Parts>,
+    /// The team of the substeps.
+    substeps: SubstepsTeam,
     /// Whether the team or one thread runs the substeps faster here ([`ThreadChoice`]).
     choice: ThreadChoice,
+}
+
+/// The team of the substeps, whose items wait only for the items they depend on
+/// ([`Team::reset_flowing`]), with what its waits were worked out for. A clone starts afresh.
+#[derive(Debug, Default)]
+struct SubstepsTeam {
+    team: Team,
+    plan: Vec<team::Parts>,
+    /// The plan and the layout (its [`Batches::generation`], the body count) for which the
+    /// team's waits were last worked out, and the bodies its items touch.
+    flow_plan: Vec<team::Parts>,
+    flow_layout: Option<(u64, usize)>,
+    touches: team::Touches,
+    /// The layout of the last step on the team.
+    last_layout: Option<(u64, usize)>,
+}
+
+impl Clone for SubstepsTeam {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
 }
 
 /// Steps between two trials of the mode not in use ([`ThreadChoice`]).
@@ -715,14 +738,34 @@ fn run_on_team(team: &mut Team, plan: &mut Vec<team::Parts>, threads: usize, wor
 /// storage, reused: no allocation once it has grown; a new `Vec` each step made 9 allocations
 /// a step on the 20-row pyramid).
 fn learn_plan(plan: &mut Vec<team::Parts>, threads: usize, run: impl FnOnce(&Plan)) {
+    learn_plan_touching(plan, None, threads, run);
+}
+
+/// [`learn_plan`], recording into `touches`, when given, the bodies each item touches
+/// ([`team::Crew::stage_on_bodies`]).
+fn learn_plan_touching(
+    plan: &mut Vec<team::Parts>,
+    touches: Option<&mut team::Touches>,
+    threads: usize,
+    run: impl FnOnce(&Plan),
+) {
     let mut stages = std::mem::take(plan);
     stages.clear();
+    let mut touches = touches;
+    let record = touches.as_mut().map(|t| {
+        t.clear();
+        std::cell::RefCell::new(std::mem::take(&mut **t))
+    });
     let planned = Plan {
         threads,
         stages: std::cell::RefCell::new(stages),
+        touches: record,
     };
     run(&planned);
     *plan = planned.stages.into_inner();
+    if let (Some(record), Some(t)) = (planned.touches, touches) {
+        *t = record.into_inner();
+    }
 }
 
 /// Batches per item of the team's stage that writes the step's results ([`Results`]).
@@ -1113,7 +1156,12 @@ impl Substeps<'_> {
         let start = (STATIC_BODY as usize + 1).min(self.states.len()) as u32;
         let end = self.states.len() as u32;
         let items = (end - start).div_ceil(self.body_chunk);
-        crew.stage(items, |i| {
+        let chunk = self.body_chunk;
+        let touches = |i: u32, push: &mut dyn FnMut(u32)| {
+            let first = start + i * chunk;
+            (first..first.saturating_add(chunk).min(end)).for_each(&mut *push);
+        };
+        crew.stage_on_bodies(items, touches, |i| {
             let first = start + i * self.body_chunk;
             let last = first.saturating_add(self.body_chunk).min(end);
             // SAFETY: the items of a stage are disjoint runs of bodies.
@@ -1156,7 +1204,20 @@ fn each_batch_range(
     for group in groups.windows(2) {
         let (start, end) = (group[0], group[1]);
         let items = (end - start).div_ceil(chunk);
-        crew.stage(items, |i| {
+        let touches = |i: u32, push: &mut dyn FnMut(u32)| {
+            let first = start + i * chunk;
+            let last = first.saturating_add(chunk).min(end);
+            for m in &manifolds[first as usize..last as usize] {
+                // SAFETY: asked while the stages are planned, when nothing writes batches.
+                let m = unsafe { m.get() };
+                for body in m.a.iter().chain(&m.b) {
+                    if *body != STATIC_BODY {
+                        push(*body);
+                    }
+                }
+            }
+        };
+        crew.stage_on_bodies(items, touches, |i| {
             let first = start + i * chunk;
             let last = first.saturating_add(chunk).min(end);
             // SAFETY: the items of a stage are disjoint runs of one group's batches, whose
@@ -1290,6 +1351,7 @@ impl Resolver for SoftStepResolver {
         };
         let substeps_start = Stopwatch::start();
         let direct_live = !self.direct.is_empty();
+        let (generation, body_count) = (self.batches.generation(), self.states.len());
         let times = {
             let Batches {
                 manifolds,
@@ -1333,13 +1395,31 @@ impl Resolver for SoftStepResolver {
                 },
             };
             if threads > 1 {
-                learn_plan(&mut self.plan, threads, |plan| {
+                let team = &mut self.substeps;
+                learn_plan(&mut team.plan, threads, |plan| {
                     work.run(plan, &Timing::default());
                 });
-                self.team.reset(threads, &self.plan);
+                // The waits between items depend on the stages and on the bodies each item
+                // touches: worked out when a layout is kept a second step (contacts that
+                // change every step pay no more than before), and kept with it.
+                let layout = (generation, body_count);
+                if team.flow_layout == Some(layout) && team.flow_plan == team.plan {
+                    team.team.reset_flowing(threads, &team.plan, None);
+                } else if team.last_layout == Some(layout) {
+                    learn_plan_touching(&mut team.plan, Some(&mut team.touches), threads, |plan| {
+                        work.run(plan, &Timing::default());
+                    });
+                    team.team
+                        .reset_flowing(threads, &team.plan, Some(&team.touches));
+                    team.flow_plan.clone_from(&team.plan);
+                    team.flow_layout = Some(layout);
+                } else {
+                    team.team.reset(threads, &team.plan);
+                }
+                team.last_layout = Some(layout);
                 // The first thread's times: each stage's wall time, waits included.
                 let times = std::sync::Mutex::new([Duration::ZERO; 3]);
-                team::run(&self.team, |member| {
+                team::run(&self.substeps.team, |member| {
                     let timing = Timing::default();
                     work.run(member, &timing);
                     if member.id() == 0
