@@ -191,6 +191,7 @@ pub(crate) fn gather(
             let mut sb = SolverBody::new(body.position, body.orientation, 0.0, Mat3::ZERO);
             sb.linear_velocity = body.linear_velocity;
             sb.angular_velocity = body.angular_velocity;
+            sb.path_acceleration = body.path_acceleration();
             if body.angular_velocity != Vec3::ZERO {
                 // Its angular terms are zero (no inverse inertia), but its pose turns.
                 sb.flags |= SolverBody::ROTATES;

@@ -1425,7 +1425,7 @@ impl World {
         if self.paths {
             let end = self.time + f64::from(dt);
             for (_, body) in self.bodies.iter_mut() {
-                body.follow_path(end);
+                body.follow_path_over(self.time, end);
             }
         }
 

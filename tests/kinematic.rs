@@ -494,11 +494,39 @@ fn scene_kinematic_fields_are_checked() {
 /// with the table) to 10 s the radius changes by less than 1 mm, and in the Millington
 /// resolver by less than that plus its velocity epsilon times the 8 s: its velocity pass
 /// leaves a contact sliding slower than the epsilon alone, and the box creeps outward at about
-/// that speed (ε 10⁻⁴ m/s: 2.6 mm from 2 s to 20 s; ε 10⁻⁵: 0.7 mm; ε 10⁻⁶: 0.2 mm). (A table
-/// turning about an axis off its centre still drifts in the soft step: benches/RESULTS.md,
-/// "Loads on a turntable".)
+/// that speed (ε 10⁻⁴ m/s: 2.6 mm from 2 s to 20 s; ε 10⁻⁵: 0.7 mm; ε 10⁻⁶: 0.2 mm).
 #[test]
 fn loads_on_a_turntable_keep_their_radius() {
+    let drifted = turntables_that_drift(0.0);
+    assert!(drifted.is_empty(), "{drifted:#?}");
+}
+
+/// [`loads_on_a_turntable_keep_their_radius`] on tables whose centre lies off the axis they
+/// turn about, by 1 to 4 times the load's radius, on the far side of the axis: the table's
+/// centre goes round a circle, and the soft step held a load to the table's mean velocity over
+/// the step (from 2 s to 10 s the soft step's loads moved 0.6–672 mm outward; a 0.1 m box at
+/// 1 m, the table's centre 4 m from the axis, 262 mm at 60 Hz). It now moves a kinematic body
+/// on a path through each substep at that substep's velocity
+/// (`SolverBody::path_acceleration`): 0.0–4.8 mm. Ignored: 7 of the 42 cases still creep
+/// outward, steadily (0.2–0.6 mm/s): in the soft step 5 cases by 2.2–4.8 mm, all at 60 Hz
+/// with the table's centre moving at 4 m/s or more (at 120 Hz the same 0.2 m box at 3 m
+/// holds); in the Millington resolver, whose friction this does not change, 2 by 2.1 mm
+/// (its bound here 1.8 mm). benches/RESULTS.md ("A turn about an axis off the table")
+/// leaves it open. Run with `cargo test --release --test kinematic -- --ignored
+/// off_its_centre --nocapture`.
+#[test]
+#[ignore = "loads on tables turning off their centre still creep 0.2-0.6 mm/s in 7 of 42 cases"]
+fn loads_on_a_table_turning_off_its_centre_keep_their_radius() {
+    let drifted: Vec<String> = [1.0, 2.0, 4.0]
+        .into_iter()
+        .flat_map(turntables_that_drift)
+        .collect();
+    assert!(drifted.is_empty(), "{drifted:#?}");
+}
+
+/// The cases of [`loads_on_a_turntable_keep_their_radius`], each table centred `off` times
+/// the load's radius from the axis, on the far side: those whose load drifted.
+fn turntables_that_drift(off: f32) -> Vec<String> {
     use jostle::KinematicPath;
     let mut drifted = Vec::new();
     for (resolver, (half, radius, share, mu, rate)) in
@@ -526,14 +554,17 @@ fn loads_on_a_turntable_keep_their_radius() {
             _ => 0.0,
         };
         let mut w = world(resolver);
-        let table_half = Vec3::new(radius + 2.0 * half + 1.0, 0.1, radius + 2.0 * half + 1.0);
+        // The table reaches past the load and past the axis on the other side.
+        let centre = Vec3::new(-off * radius, 0.1, 0.0);
+        let reach = radius + 2.0 * half + 1.0;
+        let table_half = Vec3::new(off * radius + reach, 0.1, reach);
         let table = w
-            .add_body(boxed("table", table_half, Vec3::new(0.0, 0.1, 0.0)).with_material(mu, 0.0))
+            .add_body(boxed("table", table_half, centre).with_material(mu, 0.0))
             .unwrap();
         w.set_path(
             table,
             Some(KinematicPath::Turn {
-                start: Vec3::new(0.0, 0.1, 0.0),
+                start: centre,
                 rotation: Quat::IDENTITY,
                 center: Vec3::ZERO,
                 axis: Vec3::Y,
@@ -567,7 +598,8 @@ fn loads_on_a_turntable_keep_their_radius() {
         let v = w.body(load).unwrap().linear_velocity;
         let carried = Vec3::new(v.x, 0.0, v.z).length() / (omega * end);
         let case = format!(
-            "{name}: {half} m box at {radius} m, period {period:.2} s, μ {mu}, {rate} Hz: radius {settled:.4} m at 2 s, {end:.4} m at 10 s, speed {carried:.4} of the table's"
+            "{name}: {half} m box at {radius} m, table centred {:.1} m off the axis, period {period:.2} s, μ {mu}, {rate} Hz: radius {settled:.4} m at 2 s, {end:.4} m at 10 s, speed {carried:.4} of the table's",
+            off * radius
         );
         println!("{case}");
         // False for a NaN radius too.
@@ -578,5 +610,5 @@ fn loads_on_a_turntable_keep_their_radius() {
             drifted.push(case);
         }
     }
-    assert!(drifted.is_empty(), "{drifted:#?}");
+    drifted
 }

@@ -132,6 +132,10 @@ pub struct RigidBody {
     /// ([`RigidBody::set_next_pose`]).
     #[cfg_attr(feature = "serde", serde(default))]
     next_pose: Option<(Vec3, Quat)>,
+    /// The acceleration of a body sent along its path for the next step, at the middle of
+    /// the step ([`RigidBody::follow_path_over`]; zero otherwise).
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "is_zero"))]
+    path_acceleration: Vec3,
     /// The scripted motion of a position-based kinematic body ([`RigidBody::set_path`]).
     #[cfg_attr(
         feature = "serde",
@@ -159,6 +163,11 @@ pub struct RigidBody {
 #[cfg(feature = "serde")]
 fn one() -> f32 {
     1.0
+}
+
+#[cfg(feature = "serde")]
+fn is_zero(v: &Vec3) -> bool {
+    *v == Vec3::ZERO
 }
 
 impl RigidBody {
@@ -243,6 +252,7 @@ impl RigidBody {
                 self.angular_velocity = Vec3::ZERO;
             }
             self.next_pose = None;
+            self.path_acceleration = Vec3::ZERO;
             if body_type != BodyType::KinematicPosition {
                 self.path = None;
             }
@@ -261,6 +271,7 @@ impl RigidBody {
         }
         dynamic.locked_while_fixed = false;
         dynamic.next_pose = None;
+        dynamic.path_acceleration = Vec3::ZERO;
         dynamic.path = None;
         dynamic.sleep.awake = true;
         *self = dynamic;
@@ -303,6 +314,7 @@ impl RigidBody {
     pub fn set_next_pose(&mut self, position: Vec3, orientation: Quat) {
         if self.body_type == BodyType::KinematicPosition {
             self.next_pose = Some((position, orientation.normalize()));
+            self.path_acceleration = Vec3::ZERO;
         }
     }
 
@@ -331,6 +343,27 @@ impl RigidBody {
         true
     }
 
+    /// [`RigidBody::follow_path`] for a step from time `start` to `end` (s), which also
+    /// records the path's acceleration at the middle of the step
+    /// ([`RigidBody::path_acceleration`]): the step's velocity is the mean one, and a
+    /// resolver can move the body through the step at the velocity of each instant.
+    pub fn follow_path_over(&mut self, start: f64, end: f64) -> bool {
+        if !self.follow_path(end) {
+            return false;
+        }
+        if let Some(path) = self.path {
+            self.path_acceleration = path.acceleration_at(0.5 * (start + end));
+        }
+        true
+    }
+
+    /// The acceleration at the middle of the coming step of a body sent along its path by
+    /// [`RigidBody::follow_path_over`] (m/s²); zero for a body sent anywhere else, or
+    /// nowhere.
+    pub fn path_acceleration(&self) -> Vec3 {
+        self.path_acceleration
+    }
+
     /// The next pose of a position-based kinematic body, taken for the step: sets the
     /// velocities that reach it in `dt` (zero without one) and returns it, so that the pose
     /// can be set exactly at the end of the step.
@@ -341,6 +374,7 @@ impl RigidBody {
         let Some((position, orientation)) = self.next_pose.take() else {
             self.linear_velocity = Vec3::ZERO;
             self.angular_velocity = Vec3::ZERO;
+            self.path_acceleration = Vec3::ZERO;
             return None;
         };
         self.linear_velocity = (position - self.position) / dt;
@@ -381,6 +415,7 @@ impl RigidBody {
             body_type: BodyType::Fixed,
             locked_while_fixed: false,
             next_pose: None,
+            path_acceleration: Vec3::ZERO,
             path: None,
             gravity_scale: 1.0,
             origin_offset: Vec3::ZERO,

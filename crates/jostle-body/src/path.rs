@@ -90,6 +90,28 @@ impl KinematicPath {
         }
     }
 
+    /// The acceleration (m/s²) of the body's position at time `t` (s): what turns a step's
+    /// mean velocity into the velocity at each instant of the step.
+    pub fn acceleration_at(&self, t: f64) -> Vec3 {
+        match *self {
+            Self::Line { offset, period, .. } => {
+                let rate = TAU / period as f64;
+                let phase = (t / period as f64).fract() * TAU;
+                offset * (0.5 * rate * rate * phase.cos()) as f32
+            }
+            Self::Turn {
+                center,
+                axis,
+                period,
+                ..
+            } => {
+                let (position, _) = self.pose_at(t);
+                let spin = axis.normalize_or_zero() * (TAU / period as f64) as f32;
+                spin.cross(spin.cross(position - center))
+            }
+        }
+    }
+
     /// Checks the path's numbers: the field at fault and why.
     pub fn check(&self) -> Result<(), (&'static str, String)> {
         let vector = |field: &'static str, v: Vec3| {
@@ -202,6 +224,46 @@ mod tests {
         // Far into a run the phase is still exact.
         let (p, _) = path.pose_at(8.0 * 1e6 + 2.0);
         assert!((p - Vec3::new(0.0, 1.0, -2.0)).length() < 1e-4, "{p}");
+    }
+
+    /// The acceleration is the second difference of the poses, for lines and turns (either
+    /// way round, about axes through or off the start).
+    #[test]
+    fn the_acceleration_is_the_paths_second_difference() {
+        let paths = [
+            KinematicPath::Line {
+                start: Vec3::new(1.0, 2.0, 3.0),
+                rotation: Quat::IDENTITY,
+                offset: Vec3::new(0.5, 0.0, -2.0),
+                period: 3.0,
+            },
+            KinematicPath::Turn {
+                start: Vec3::new(2.0, 1.0, 0.5),
+                rotation: Quat::IDENTITY,
+                center: Vec3::new(-1.0, 0.0, 0.0),
+                axis: Vec3::new(0.0, 2.0, 0.5),
+                period: 5.0,
+            },
+            KinematicPath::Turn {
+                start: Vec3::new(0.0, 1.0, 0.0),
+                rotation: Quat::IDENTITY,
+                center: Vec3::ZERO,
+                axis: Vec3::Y,
+                period: -2.0,
+            },
+        ];
+        let h = 1e-2;
+        for path in &paths {
+            for t in [0.0, 0.4, 1.3, 2.9] {
+                let x = |t: f64| path.pose_at(t).0.as_dvec3();
+                let numeric = (x(t + h) - 2.0 * x(t) + x(t - h)) / (h * h);
+                let a = path.acceleration_at(t).as_dvec3();
+                assert!(
+                    (a - numeric).length() < 1e-2 * numeric.length().max(1.0),
+                    "{path:?} at {t}: {a} against {numeric}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -48,6 +48,11 @@ pub struct SolverBody {
     /// The change of angular velocity this step's applied torques (and damping) make over the
     /// whole step (rad/s), added the same way.
     pub torque_velocity: Vec3,
+    /// A kinematic body's acceleration at the middle of the step (m/s²), when it follows a
+    /// curved path: `linear_velocity` is then its mean velocity over the step, and a resolver
+    /// may move it through the step at `linear_velocity + path_acceleration·(t − dt/2)`. Zero
+    /// for every other body.
+    pub path_acceleration: Vec3,
 }
 
 const _: () = assert!(size_of::<SolverBody>() <= 144);
@@ -79,6 +84,7 @@ impl SolverBody {
         last_acceleration: Vec3::ZERO,
         force_velocity: Vec3::ZERO,
         torque_velocity: Vec3::ZERO,
+        path_acceleration: Vec3::ZERO,
     };
 
     /// A dynamic body at `position` with the given inverse mass and world inverse inertia,
@@ -96,6 +102,7 @@ impl SolverBody {
             last_acceleration: Vec3::ZERO,
             force_velocity: Vec3::ZERO,
             torque_velocity: Vec3::ZERO,
+            path_acceleration: Vec3::ZERO,
         }
     }
 

@@ -358,22 +358,45 @@ impl SoftStepResolver {
     /// L = I·ω with ω itself, and its turns need no term, `gyroscopic::is_isotropic`; zero too
     /// for a body whose moments differ more than f32 world tensors hold,
     /// `gyroscopic::within_f32`).
-    fn load_bodies(&mut self, bodies: &[SolverBody]) {
+    fn load_bodies(&mut self, bodies: &[SolverBody], dt: f32) {
         self.states.clear();
         self.states.extend(bodies.iter().map(BodyState::from_body));
         self.pushes.clear();
         let zero = jostle_math::Vec3::ZERO;
+        // The acceleration of an immovable body on a curved path
+        // (`SolverBody::path_acceleration`).
+        let path = |b: &SolverBody| {
+            if b.inv_mass == 0.0 {
+                b.path_acceleration
+            } else {
+                zero
+            }
+        };
         if bodies
             .iter()
-            .any(|b| b.force_velocity != zero || b.torque_velocity != zero)
+            .any(|b| b.force_velocity != zero || b.torque_velocity != zero || path(b) != zero)
         {
             let share = 1.0 / self.settings.substeps.max(1) as f32;
+            let h = dt * share;
             self.pushes.extend(bodies.iter().map(|b| {
                 [
-                    b.force_velocity * b.linear_freedom() * share,
+                    b.force_velocity * b.linear_freedom() * share + path(b) * h,
                     b.torque_velocity * share,
                 ]
             }));
+            // A body on a curved path starts half a step and half a substep back along its
+            // acceleration: each substep's push then brings it to its velocity in the middle
+            // of that substep, and over the step it moves by its mean velocity. With the step's
+            // mean velocity throughout, a load on a table turning about an axis off the
+            // table's centre was held to the table's velocity in the middle of the step, and
+            // the table's point turned away from it on either side (benches/RESULTS.md, "A
+            // turn about an axis off the table").
+            for (state, b) in self.states.iter_mut().zip(bodies) {
+                let a = path(b);
+                if a != zero {
+                    state.linear_velocity -= a * (0.5 * (dt + h));
+                }
+            }
         }
         self.pseudo.clear();
         self.pseudo.resize(bodies.len(), [0.0; 8]);
@@ -1280,7 +1303,7 @@ impl Resolver for SoftStepResolver {
         let inv_h = if h > 0.0 { 1.0 / h } else { 0.0 };
 
         let start = Stopwatch::start();
-        self.load_bodies(bodies);
+        self.load_bodies(bodies, ctx.dt);
         let params = self.arrange_contacts(bodies, contacts, h, ctx.gravity);
         let any_restitution = self.batches.any_restitution;
         self.mark_free();
@@ -1538,7 +1561,13 @@ impl Resolver for SoftStepResolver {
             );
         }
         for (body, state) in bodies.iter_mut().zip(&self.states).skip(1) {
+            let mean = body.linear_velocity;
             state.store(body);
+            if body.path_acceleration != jostle_math::Vec3::ZERO && body.inv_mass == 0.0 {
+                // A body on a curved path leaves the step with the step's mean velocity, as
+                // it came (`load_bodies`).
+                body.linear_velocity = mean;
+            }
             body.last_acceleration = if body.inv_mass > 0.0 {
                 ctx.gravity * body.linear_freedom()
             } else {
@@ -1720,6 +1749,63 @@ mod carried_warm_start_tests {
         assert!(
             worst <= 1e-5 * scale,
             "differs by {worst} at a scale of {scale}"
+        );
+    }
+}
+
+#[cfg(test)]
+mod path_acceleration_tests {
+    use super::*;
+    use jostle_math::{Quat, Vec3};
+
+    /// A platform on a path (immovable, its mean velocity over the step and its acceleration
+    /// given) with a box sticking on it: the platform ends the step where its mean velocity
+    /// takes it and leaves with that velocity, and the box, held by friction to the platform
+    /// through the substeps from the platform's velocity at the start of the step, leaves with
+    /// the platform's velocity in the middle of the last substep, v + a·(dt/2 − h/2): with the
+    /// mean velocity throughout, friction took it to v.
+    #[test]
+    fn a_platform_on_a_path_moves_at_each_substeps_velocity() {
+        let (dt, substeps) = (1.0 / 60.0, 8u32);
+        let h = dt / substeps as f32;
+        let (v, a) = (Vec3::new(2.0, 0.0, 0.0), Vec3::new(3.0, 0.0, 1.0));
+        let mut platform = SolverBody::new(Vec3::ZERO, Quat::IDENTITY, 0.0, Mat3::ZERO);
+        platform.linear_velocity = v;
+        platform.path_acceleration = a;
+        let mut load = SolverBody::new(
+            Vec3::new(0.0, 0.5, 0.0),
+            Quat::IDENTITY,
+            1.0,
+            Mat3::from_diagonal(Vec3::splat(6.0)),
+        );
+        // Sticking: at the start of the step it moves as the platform does then.
+        load.linear_velocity = v - a * (0.5 * dt);
+        let mut bodies = vec![SolverBody::STATIC, platform, load];
+        let mut contacts: Vec<Contact> = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)]
+            .map(|(x, z)| Contact::new(2, 1, Vec3::new(x, 0.0, z), Vec3::Y, 0.0).with_friction(1.0))
+            .to_vec();
+        let mut resolver = SoftStepResolver::new(SoftStepSettings {
+            substeps,
+            ..SoftStepSettings::default()
+        });
+        let ctx = StepContext {
+            gravity: Vec3::new(0.0, -9.81, 0.0),
+            dt,
+        };
+        resolver.step(&mut bodies, &mut contacts, &ctx);
+        let (platform, load) = (&bodies[1], &bodies[2]);
+        assert!(
+            (platform.position - v * dt).length() < 1e-6,
+            "{}",
+            platform.position
+        );
+        assert_eq!(platform.linear_velocity, v);
+        let expected = v + a * (0.5 * (dt - h));
+        let horizontal = |w: Vec3| Vec3::new(w.x, 0.0, w.z);
+        assert!(
+            (horizontal(load.linear_velocity) - horizontal(expected)).length() < 1e-3,
+            "{} against {expected}",
+            load.linear_velocity
         );
     }
 }
