@@ -1440,7 +1440,8 @@ impl Resolver for SoftStepResolver {
                     team.team.reset(threads, &team.plan);
                 }
                 team.last_layout = Some(layout);
-                // The first thread's times: each stage's wall time, waits included.
+                // The first thread's times: each stage's wall time, waits included (in a
+                // flow, a stage's waits fall in the later stages whose items wait).
                 let times = std::sync::Mutex::new([Duration::ZERO; 3]);
                 team::run(&self.substeps.team, |member| {
                     let timing = Timing::default();

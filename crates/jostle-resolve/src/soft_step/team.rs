@@ -6,15 +6,17 @@
 //! colour, the direct solve, integrate the positions, relax colour by colour. A stage is a number of *items* (a few batches of one
 //! colour, or a run of bodies) that write disjoint data, so they may run in any order and on
 //! any thread with the same result, bit for bit; a stage starts only when the one before has
-//! finished. Every thread of the team runs the same sequence ([`Crew::stage`]):
+//! finished (in a flow, below, an item starts when the items it depends on have). Every thread
+//! of the team runs the same sequence ([`Crew::stage`]):
 //! - each stage's items are split into one contiguous part per thread, of equal counts
 //!   ([`Plan`]); the soft step orders each colour's batches by the bodies they write, so a
 //!   thread's part of every colour touches about the same bodies, and their states stay in
 //!   its core's cache;
 //! - items are claimed through an atomic counter per part; a thread runs its own part, then
 //!   the parts of threads that have not reached the stage yet, and then waits only for items
-//!   that a running thread has claimed. A thread that starts late, or never, holds nothing
-//!   up: the others take its part. So the team cannot deadlock, however many helpers join.
+//!   that a running thread has claimed (in a flow it does not wait at the stage's end at all).
+//!   A thread that starts late, or never, holds nothing up: the others take its part. So the
+//!   team cannot deadlock, however many helpers join.
 //!
 //! The substeps' team runs as a *flow* once a step's batches are laid out as the step before's
 //! ([`Team::reset_flowing`]): a stage whose items list the bodies they touch
@@ -59,9 +61,13 @@ pub trait Crew {
     /// through bodies: `touches(i, push)` pushes every body whose data item `i` reads or
     /// writes, and any two items of different stages that share any datum both push some
     /// body they share (the points of a batch are shared by its items of the biased and the
-    /// relax pass, which push the batch's bodies). On a team prepared for it
-    /// ([`Team::reset_flowing`]) an item then waits only for the items before it that touch
-    /// its bodies, not for the whole stage before; the results are the same, bit for bit.
+    /// relax pass, which push the batch's bodies); no two items of the stage push the same
+    /// body. On a team prepared for it ([`Team::reset_flowing`]) an item then waits only for
+    /// the items before it that touch its bodies, not for the whole stage before, and the call
+    /// returns when this thread's items have finished, not all of them: code between two such
+    /// stages must not read what their items write (a [`Crew::stage`] waits for everything
+    /// before it, and [`Member::finish`] for everything). The results are the same, bit for
+    /// bit.
     fn stage_on_bodies(
         &self,
         items: u32,
@@ -285,7 +291,16 @@ impl Flow {
                 body_start = end;
             }
             // Then the stage's items become the last to touch their bodies (items of one
-            // stage never wait for each other).
+            // stage never wait for each other, so none may touch a body another touches: a
+            // later item would wait for only one of them).
+            #[cfg(debug_assertions)]
+            {
+                let mut seen: Vec<u32> = touches.bodies[stage_bodies..body_start].to_vec();
+                seen.sort_unstable();
+                let before = seen.len();
+                seen.dedup();
+                debug_assert_eq!(seen.len(), before, "stage {k}: two items touch one body");
+            }
             let mut start = stage_bodies;
             for i in 0..items as usize {
                 let end = touches.ends[item_end + i] as usize;
@@ -328,7 +343,17 @@ impl Team {
                 debug_assert!(self.flow.active && self.flow.first.len() == plan.len());
             }
         }
-        self.flow.epoch = self.flow.epoch.wrapping_add(1).max(1);
+        if self.flow.epoch == u32::MAX {
+            // Every flag back to 0, below every epoch to come: no flag left from an earlier
+            // round of epochs can read as finished.
+            for line in &mut self.flow.flags {
+                for flag in &mut line.0 {
+                    *flag.get_mut() = 0;
+                }
+            }
+            self.flow.epoch = 0;
+        }
+        self.flow.epoch += 1;
         self.reset_counters(threads, plan);
     }
 
@@ -454,7 +479,7 @@ impl Member<'_> {
         let mut ran = 0;
         loop {
             // Relaxed: the claim only has to be unique; the data an item reads was published
-            // by the wait that ended the stage before.
+            // by the wait that ended the stage before (in a flow, by the flags it waits for).
             let i = slot.next[part].0.fetch_add(1, Ordering::Relaxed);
             if i >= end {
                 return ran;
@@ -914,8 +939,8 @@ mod tests {
     /// On a team reset to flow, every item runs once, after every item of an earlier stage
     /// that touches one of its bodies and before every later one, for any number of threads
     /// (helpers may join late or not at all), with stages listed by body and stages not
-    /// listed (which wait for everything before them) mixed; and again on the next step,
-    /// with the waits kept.
+    /// listed (which wait for everything before them) mixed; and again on the next steps,
+    /// with the waits kept, across the wrap of the steps' epoch.
     #[test]
     fn flowing_items_run_after_the_items_before_them_on_their_bodies() {
         const BODIES: u32 = 40;
@@ -970,9 +995,24 @@ mod tests {
             let parts = plan.stages.into_inner();
             let touches = plan.touches.map(RefCell::into_inner).unwrap_or_default();
             let mut team = Team::default();
-            for step in 0..3u32 {
+            for step in 0..4u32 {
                 let keep = step > 0;
+                if step == 1 {
+                    // Steps 2 and 3 run across the epoch's wrap: the flags step 0 left (its
+                    // epoch, 1) must not read as finished at the epoch 1 of step 3.
+                    team.flow.epoch = u32::MAX - 1;
+                }
                 team.reset_flowing(threads, &parts, (!keep).then_some(&touches));
+                // At a step's start no flag reads as finished, nor could at a later epoch.
+                let epoch = team.flow.epoch;
+                assert!(
+                    team.flow
+                        .flags
+                        .iter()
+                        .flat_map(|line| &line.0)
+                        .all(|f| f.load(Ordering::Relaxed) < epoch),
+                    "{threads} threads, step {step}: a flag at or past epoch {epoch}"
+                );
                 // Per body: the items that have touched it so far.
                 let seen: Vec<AtomicU64> = (0..BODIES).map(|_| AtomicU64::new(0)).collect();
                 let early = AtomicBool::new(false);
