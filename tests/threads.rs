@@ -39,25 +39,23 @@ fn any_number_of_threads_gives_bit_identical_steps() {
 
 /// The state hashes of `steps` steps of `scene` on one, two and three threads agree.
 fn same_for_any_threads(scene: &str, steps: u32) {
-    {
-        let (one, teams, parts) = run(scene, 1, steps);
-        assert_eq!((teams, parts), (1, 1));
-        for threads in [2, 3] {
-            let (hashes, teams, parts) = run(scene, threads, steps);
-            assert_eq!(
-                teams, threads as u32,
-                "{scene}, {threads} threads: no step ran on a team of that size"
-            );
-            assert_eq!(
-                parts, threads,
-                "{threads} threads: no step split the narrow phase's pairs that many ways"
-            );
-            let first = one.iter().zip(&hashes).position(|(a, b)| a != b);
-            assert_eq!(
-                first, None,
-                "{scene}, {threads} threads differ from one from that step on"
-            );
-        }
+    let (one, teams, parts) = run(scene, 1, steps);
+    assert_eq!((teams, parts), (1, 1));
+    for threads in [2, 3] {
+        let (hashes, teams, parts) = run(scene, threads, steps);
+        assert_eq!(
+            teams, threads as u32,
+            "{scene}, {threads} threads: no step ran on a team of that size"
+        );
+        assert_eq!(
+            parts, threads,
+            "{scene}, {threads} threads: no step split the narrow phase's pairs that many ways"
+        );
+        let first = one.iter().zip(&hashes).position(|(a, b)| a != b);
+        assert_eq!(
+            first, None,
+            "{scene}, {threads} threads differ from one from that step on"
+        );
     }
     jostle::set_threads(0);
 }
