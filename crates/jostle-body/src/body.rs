@@ -348,12 +348,11 @@ impl RigidBody {
     /// ([`RigidBody::path_acceleration`]): the step's velocity is the mean one, and a
     /// resolver can move the body through the step at the velocity of each instant.
     pub fn follow_path_over(&mut self, start: f64, end: f64) -> bool {
-        if !self.follow_path(end) {
+        let Some(path) = self.path else {
             return false;
-        }
-        if let Some(path) = self.path {
-            self.path_acceleration = path.acceleration_at(0.5 * (start + end));
-        }
+        };
+        self.follow_path(end);
+        self.path_acceleration = path.acceleration_at(0.5 * (start + end));
         true
     }
 

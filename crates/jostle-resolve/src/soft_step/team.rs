@@ -238,9 +238,7 @@ impl Flow {
     fn flag(&self, f: u32) -> &AtomicU32 {
         &self.flags[(f / FLAGS_PER_LINE) as usize].0[(f % FLAGS_PER_LINE) as usize]
     }
-}
 
-impl Flow {
     /// Rebuilds the waits for the stages of `plan`, whose bodies `touches` lists, on a team
     /// of `threads`.
     fn build(&mut self, plan: &[Parts], touches: &Touches, threads: usize) {
