@@ -354,9 +354,13 @@ fn a_body_gliding_or_turning_steadily_is_not_put_to_sleep() {
 }
 
 /// A box on a slope steeper than its friction angle slides down it as Coulomb friction says,
-/// sleep on: ½·g·(sin θ − μ·cos θ)·t² in 5 s, within 10% (the soft step; the Millington
-/// resolver slides further near the friction angle, 2.1–2.2 m at 27° and 4.2–4.4 m at 28°
-/// against 1.04 and 3.43, and is held only to sliding at least 90% as far). With the motion
+/// sleep on: ½·g·(sin θ − μ·cos θ)·t² in 5 s, within 10%. The Millington resolver within 10%
+/// at 35° only: nearer the friction angle its start shows, while the box rocks on its corners
+/// and its friction keeps Cyclone's tilted direction (1.54 m at 27° against 1.04, 3.81 m at
+/// 28° against 3.43); once sliding its friction is μ·N to 0.1%
+/// (`friction_is_dynamic_once_sliding_whatever_mu` in jostle-resolve). There it is held to
+/// sliding at least 90% and at most 1.6 times as far (before that test's fix: 2.1–2.2 m at
+/// 27°, 4.2–4.4 m at 28°). With the motion
 /// average alone the box (μ 0.5) stopped asleep within 1.2 s on slopes of 27° and 28°
 /// (friction angle 26.6°), after 0.05 and 0.18 m.
 #[test]
@@ -389,11 +393,11 @@ fn a_box_on_a_slope_steeper_than_its_friction_angle_slides_and_does_not_sleep() 
                     2.0 * half
                 );
                 println!("{case}");
-                // The Millington resolver's sliding friction falls about 2% short of μ (0.49
-                // for 0.5), which doubles the slide 0.4° above the friction angle: only held
-                // to not stopping here.
+                // The Millington resolver's start (above) shows near the friction angle.
                 let held = match r {
-                    ResolverChoice::Millington(_) => slid > 0.9 * expected,
+                    ResolverChoice::Millington(_) if degrees < 30.0 => {
+                        slid > 0.9 * expected && slid < 1.6 * expected
+                    }
                     _ => (slid - expected).abs() < 0.1 * expected,
                 };
                 if !(awake && held) {
