@@ -34,6 +34,22 @@ fn family() -> Vec<Case> {
     cases
 }
 
+/// Cubes of 0.1, 1 and 10 m at μs 0.9, μd 0.85: sliding only (the Millington resolver holds a
+/// box at rest up to about 0.9·μs, so a push between these coefficients moves it; benches/
+/// RESULTS.md, "Sliding friction at any μ in the Millington resolver"). Its box slid 4–10% too
+/// far here (0.96–1.02 m against 0.93) before its friction was made to oppose a fast slide
+/// whatever the normal impulse of the stop-dead solve.
+fn high_friction() -> Vec<Case> {
+    [0.1, 1.0, 10.0]
+        .into_iter()
+        .map(|size| Case {
+            size,
+            mu_s: 0.9,
+            mu_d: 0.85,
+        })
+        .collect()
+}
+
 /// The case's cube resting on the ground, moving at `speed` along x; sleeping off.
 fn cube_on_ground(resolver: &ResolverChoice, case: Case, speed: f32) -> (World, BodyHandle, f32) {
     let mut settings = WorldSettings {
@@ -91,22 +107,28 @@ fn acceleration(track: &[(f32, f32)], i: usize, j: usize) -> f32 {
 #[test]
 fn a_sliding_box_decelerates_at_the_dynamic_coefficient() {
     for r in resolvers() {
-        for case in family() {
+        for case in family().into_iter().chain(high_friction()) {
             let (mut w, cube, _) = cube_on_ground(&r, case, 4.0);
             let track = run(&mut w, cube, Vec3::ZERO, 2.0);
-            // Between 0.1 s and 0.8 s it is sliding all along: −μd·g (μs would be far more).
-            let a = acceleration(&track, 6, 48);
+            // From 0.1 s to 0.8 s or 80% of its time to stop, whichever is first, it is
+            // sliding all along: −μd·g (μs would be far more).
+            let stop = 4.0 / (case.mu_d * G);
+            let end = ((0.8 * stop).min(0.8) / DT) as usize;
+            let a = acceleration(&track, 6, end);
             let expected = -case.mu_d * G;
             assert!(
                 (a - expected).abs() < 0.02 * expected.abs(),
                 "{} {case:?}: deceleration {a} m/s², expected {expected}",
                 r.name()
             );
-            // It stops after v₀²/(2·μd·g), and stays stopped.
+            // It stops after v₀²/(2·μd·g), and stays stopped. (Less up to v₀·dt/2 for a
+            // step's poses integrated with its velocity after the change, as both resolvers
+            // integrate: the Millington resolver once a step, the soft step once a substep.)
             let (x, v) = *track.last().unwrap();
             let distance = 16.0 / (2.0 * case.mu_d * G);
+            let lag = 0.5 * 4.0 * DT;
             assert!(
-                (x - distance).abs() < 0.03 * distance,
+                x > distance - lag - 0.03 * distance && x < distance + 0.03 * distance,
                 "{} {case:?}: slid {x} m, expected {distance}",
                 r.name()
             );

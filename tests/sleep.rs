@@ -356,8 +356,8 @@ fn a_body_gliding_or_turning_steadily_is_not_put_to_sleep() {
 /// A box on a slope steeper than its friction angle slides down it as Coulomb friction says,
 /// sleep on: ½·g·(sin θ − μ·cos θ)·t² in 5 s, within 10%. The Millington resolver within 10%
 /// at 35° only: nearer the friction angle its start shows, while the box rocks on its corners
-/// and its friction keeps Cyclone's tilted direction (1.54 m at 27° against 1.04, 3.81 m at
-/// 28° against 3.43); once sliding its friction is μ·N to 0.1%
+/// and its friction keeps Cyclone's tilted direction (1.56–1.57 m at 27° against 1.04, 3.81 m
+/// at 28° against 3.43); once sliding its friction is μ·N to 0.1%
 /// (`friction_is_dynamic_once_sliding_whatever_mu` in jostle-resolve). There it is held to
 /// sliding at least 90% and at most 1.6 times as far (before that test's fix: 2.1–2.2 m at
 /// 27°, 4.2–4.4 m at 28°). With the motion

@@ -84,6 +84,8 @@ fn lever_case(
     let contact = Contact::new(1, STATIC_BODY, Vec3::ZERO, Vec3::Y, 0.0).with_friction(mu);
     let mut p = prepare(&contact, &bodies, DT, 0.25).expect("valid");
     p.velocity = velocity;
+    // Moving so before the step too (no acceleration this step).
+    p.sliding_before = velocity.y.hypot(velocity.z);
     p.desired_delta_velocity = desired;
     (bodies, p)
 }

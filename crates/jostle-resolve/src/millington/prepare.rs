@@ -25,6 +25,11 @@ pub struct PreparedContact {
     /// Velocity along the normal produced by the last step's acceleration (m/s), the lecture's
     /// v_acc: ((a_A − a_B) · dt) · n.
     pub acc_velocity: f32,
+    /// How fast the contact slid before this step's accelerations (m/s): the planar part of
+    /// `velocity` less that of (a_A − a_B) · dt. Coulomb's rule: a contact that was not sliding
+    /// is held by static friction, so where its pick leaves the friction cone it keeps the
+    /// direction of the static solution ([`super::velocity::coulomb_accumulated`]).
+    pub sliding_before: f32,
     /// Closing speed (m/s, ≥ 0) the contact gained after its surfaces met: a contact found
     /// overlapping by d, closing at v_r at the start of the step under a closing acceleration
     /// a_n, has been accelerating for d/|v_r| and met at |v_r| − |a_n|·d/|v_r|. The bounce is
@@ -131,6 +136,7 @@ impl PreparedContact {
             r: [Vec3::ZERO; 2],
             velocity: Vec3::ZERO,
             acc_velocity: 0.0,
+            sliding_before: 0.0,
             impact_speed_gain: 0.0,
             desired_delta_velocity: 0.0,
             target_velocity: 0.0,
@@ -368,6 +374,7 @@ pub fn prepare(
         r,
         velocity,
         acc_velocity: acc.x,
+        sliding_before: (velocity.y - acc.y).hypot(velocity.z - acc.z),
         impact_speed_gain: gain,
         desired_delta_velocity: desired,
         target_velocity: velocity.x + desired,

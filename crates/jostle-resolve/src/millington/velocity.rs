@@ -150,7 +150,15 @@ pub fn friction_pick(p: &PreparedContact, bodies: &[SolverBody]) -> FrictionPick
     let live = Vec3::new(1.0, f32::from(!dead[0]), f32::from(!dead[1]));
     let target = Vec3::new(desired, -p.velocity.y, -p.velocity.z) * live;
     let g = (k.inverse() * target) * live;
-    coulomb_accumulated(p.impulse, g, k, desired, p.friction, p.velocity * live)
+    coulomb_accumulated(
+        p.impulse,
+        g,
+        k,
+        desired,
+        p.friction,
+        p.velocity * live,
+        p.sliding_before,
+    )
 }
 
 /// `k` with each tangent direction that no impulse can move (its row and column zero to
@@ -185,7 +193,7 @@ const DEAD_DIRECTION: f32 = 1e-9;
 /// The sliding direction is not known here, so dynamic friction takes g's planar direction,
 /// as Cyclone does.
 pub fn coulomb(g: Vec3, k: Mat3, desired: f32, mu: f32) -> Vec3 {
-    coulomb_accumulated(Vec3::ZERO, g, k, desired, mu, Vec3::ZERO).applied
+    coulomb_accumulated(Vec3::ZERO, g, k, desired, mu, Vec3::ZERO, 0.0).applied
 }
 
 /// Below this sliding speed (m/s) the sliding direction is taken as undefined and dynamic
@@ -200,8 +208,11 @@ pub const SLIDING_DIRECTION_MIN_SPEED: f32 = 1e-6;
 ///   applied as solved;
 /// - dynamic: otherwise the total tangential impulse is μ·g_t,x along d̂, the direction
 ///   opposite the contact's `sliding` velocity (contact space, y and z), or g_t,planar's
-///   direction when the contact is not sliding (Cyclone always uses the latter), and the total normal X is re-solved so this pick still changes the normal velocity by
-///   `desired` (Cyclone's re-solve, shifted by what is already applied):
+///   direction when the contact is not sliding (Cyclone always uses the latter): sliding
+///   means faster, now and before this step's accelerations (`sliding_before`, m/s), than
+///   friction could stop it (see the code), and the total normal X is re-solved so this pick
+///   still changes the normal velocity by `desired` (Cyclone's re-solve, shifted by what is
+///   already applied):
 ///   X = (desired + (K·accumulated)ₓ) / (K₀₀ + μ(K₀₁d̂_y + K₀₂d̂_z)), with the denominator
 ///   guarded by [`DYNAMIC_FRICTION_MIN_RESPONSE`];
 /// - the total normal impulse is clamped to ≥ 0 (accumulated clamping: a later pick may
@@ -226,6 +237,7 @@ pub fn coulomb_accumulated(
     desired: f32,
     mu: f32,
     sliding: Vec3,
+    sliding_before: f32,
 ) -> FrictionPick {
     let total = accumulated + g;
     if !total.is_finite() {
@@ -253,22 +265,25 @@ pub fn coulomb_accumulated(
         // Only a contact that is truly sliding has a direction to oppose: one sliding faster
         // than the planar velocity change (on the tangents' mean response) of μ times the
         // normal impulse it carries: what it has pushed this step plus what this pick's
-        // normal change takes alone, desired / K₀₀ (negative where it gives some back). A
-        // resting corner that leaves the cone only through rotational coupling keeps Cyclone's
-        // direction, the better approximation of the static solution there. (The normal
-        // impulse was first the stop-dead total's, whose normal part grows with the sliding
-        // speed through the coupling: a box sliding at 9 m/s down a slope with μ = 0.9 then
-        // still took Cyclone's direction at its loaded corners, their friction ±33° off the
-        // slide and 87% of μ·N along it. Two other tests were tried: whether this pick's
-        // change alone would reverse the sliding let contacts that were all but held turn
-        // their friction, and the 40-row pyramid of the stability family fell; the normal
-        // impulse of the solution along the sliding instead of the frictionless one let a
-        // perturbed column of 10 m boxes sway by 0.8 m at a velocity epsilon of 10⁻⁶.)
+        // normal change takes alone, desired / K₀₀ (negative where it gives some back); and
+        // sliding so before this step's accelerations, Coulomb's rule (a contact at rest is
+        // held by static friction). A resting corner that leaves the cone only through
+        // rotational coupling keeps Cyclone's direction, the better approximation of the
+        // static solution there. (The normal impulse was first the stop-dead total's, whose
+        // normal part grows with the sliding speed through the coupling: a box sliding at
+        // 9 m/s down a slope with μ = 0.9 then still took Cyclone's direction at its loaded
+        // corners, their friction ±33° off the slide and 87% of μ·N along it. Without the
+        // test before the accelerations, a box at rest on a slope of 0.9·μ began to slide.
+        // Two other tests were tried: whether this pick's change alone would reverse the
+        // sliding let contacts that were all but held turn their friction, and the 40-row
+        // pyramid of the stability family fell; the normal impulse of the solution along the
+        // sliding instead of the frictionless one let a perturbed column of 10 m boxes sway by
+        // 0.8 m at a velocity epsilon of 10⁻⁶.)
         let k00 = k.x_axis.x;
         let speed = (sliding.y * sliding.y + sliding.z * sliding.z).sqrt();
         let carried = (accumulated.x + desired / k00).max(0.0);
         let capacity = 0.5 * (k.y_axis.y + k.z_axis.z) * mu * carried;
-        let (dy, dz) = if speed > capacity.max(SLIDING_DIRECTION_MIN_SPEED) {
+        let (dy, dz) = if speed.min(sliding_before) > capacity.max(SLIDING_DIRECTION_MIN_SPEED) {
             (-sliding.y / speed, -sliding.z / speed)
         } else {
             (total.y / planar, total.z / planar)
