@@ -1,7 +1,7 @@
 //! Static and dynamic friction, against their closed forms, in both resolvers, for cubes of
 //! 0.1, 1 and 10 m (1 kg to 10⁶ kg) and two pairs of coefficients: a box sliding on the ground
-//! decelerates at μd·g, one pushed with a force between μd·m·g and μs·m·g from rest stays put,
-//! and one pushed harder accelerates at F/m − μd·g. The materials' dynamic
+//! decelerates at μd·g, one pushed with a force between μd·m·g and μs·m·g from rest stays put
+//! (also at 0.95 and 0.98 of μs·m·g), and one pushed harder accelerates at F/m − μd·g. The materials' dynamic
 //! coefficient (`BodyDesc::with_dynamic_friction`, scene field `dynamic_friction`) defaults to
 //! the static one, so every scene keeps its meaning.
 
@@ -34,11 +34,10 @@ fn family() -> Vec<Case> {
     cases
 }
 
-/// Cubes of 0.1, 1 and 10 m at μs 0.9, μd 0.85: sliding only (the Millington resolver holds a
-/// box at rest up to about 0.9·μs, so a push between these coefficients moves it; benches/
-/// RESULTS.md, "Sliding friction at any μ in the Millington resolver"). Its box slid 4–10% too
-/// far here (0.96–1.02 m against 0.93) before its friction was made to oppose a fast slide
-/// whatever the normal impulse of the stop-dead solve.
+/// Cubes of 0.1, 1 and 10 m at μs 0.9, μd 0.85, sliding (a push between these coefficients
+/// is in `a_push_just_below_static_friction_moves_nothing`). The Millington resolver's box slid
+/// 4–10% too far here (0.96–1.02 m against 0.93) before its friction was made to oppose a fast
+/// slide whatever the normal impulse of the stop-dead solve.
 fn high_friction() -> Vec<Case> {
     [0.1, 1.0, 10.0]
         .into_iter()
@@ -168,6 +167,36 @@ fn a_push_below_static_friction_moves_nothing_and_above_it_slides_at_the_dynamic
             );
         }
     }
+}
+
+/// Pushed at 0.95 and 0.98 of μs·m·g from rest, a cube of 0.1, 1 or 10 m stays put for 2 s in
+/// both resolvers (μs 0.3 to 0.9, μd up to μs). The push acts at the centre, so the leading
+/// corners carry most of the load and the trailing ones hold little friction: static friction
+/// holds only if the corners share it by their load. The Millington resolver's corner picks
+/// did not (each tilted its friction across the face) and the cube slid 0.05–1.05 m in 2 s at
+/// 0.95·μs; it now moves less than 0.02 mm.
+#[test]
+fn a_push_just_below_static_friction_moves_nothing() {
+    let mut wrong = Vec::new();
+    for r in resolvers() {
+        for size in [0.1, 1.0, 10.0] {
+            for (mu_s, mu_d) in [(0.3, 0.3), (0.5, 0.45), (0.9, 0.85)] {
+                for fraction in [0.95, 0.98] {
+                    let case = Case { size, mu_s, mu_d };
+                    let (mut w, cube, mass) = cube_on_ground(&r, case, 0.0);
+                    let push = Vec3::new(fraction * mu_s * mass * G, 0.0, 0.0);
+                    let (x, v) = *run(&mut w, cube, push, 2.0).last().unwrap();
+                    if !(x.abs() < 1e-3 && v.abs() < 1e-3) {
+                        wrong.push(format!(
+                            "{} {case:?} pushed at {fraction}·μs·m·g: moved {x} m ({v} m/s)",
+                            r.name()
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    assert!(wrong.is_empty(), "{wrong:#?}");
 }
 
 #[test]

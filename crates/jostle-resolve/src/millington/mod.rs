@@ -89,8 +89,8 @@ pub use velocity::{
     DYNAMIC_FRICTION_MIN_RESPONSE, FRICTION_CAPACITY_TOLERANCE, FrictionPick, apply_impulse,
     contact_impulse, coulomb, coulomb_accumulated, friction_impulse, friction_pick,
     frictionless_impulse, has_friction_capacity, impulse_matrix, reopen_friction,
-    resolve_manifold_normals, resolve_velocity, update_velocity, velocity_change_per_unit_impulse,
-    velocity_key,
+    resolve_manifold_normals, resolve_velocity, share_manifold_friction, update_velocity,
+    velocity_change_per_unit_impulse, velocity_key,
 };
 
 use crate::clock::Stopwatch;

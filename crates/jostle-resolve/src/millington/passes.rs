@@ -6,8 +6,8 @@ use super::position::{position_key, resolvable, resolve_penetration, update_pene
 use super::prepare::PreparedContact;
 use super::settings::MillingtonSettings;
 use super::velocity::{
-    normal_key, reopen_friction, resolve_manifold_normals, resolve_velocity, update_velocity_for,
-    velocity_key,
+    normal_key, reopen_friction, resolve_manifold_normals, resolve_velocity,
+    share_manifold_friction, update_velocity_for, velocity_key,
 };
 use super::worst_first::Pass;
 use crate::SolverBody;
@@ -114,10 +114,23 @@ impl Pass for VelocityPass<'_> {
                 }
             }
         }
-        Some(resolve_velocity(
-            &mut self.contacts[contact as usize],
-            self.bodies,
-        ))
+        let mut change = resolve_velocity(&mut self.contacts[contact as usize], self.bodies);
+        if self.contacts[contact as usize].friction_saturated
+            && let Some(&[start, end]) = self.manifolds.get(contact as usize)
+            && let Some(shared) = share_manifold_friction(
+                &mut self.contacts[start as usize..end as usize],
+                self.bodies,
+                self.velocity_epsilon,
+            )
+        {
+            // The same two bodies: the picked contact is one of the manifold's points.
+            debug_assert_eq!(shared.body, change.body, "a manifold of another pair");
+            for side in 0..2 {
+                change.linear[side] += shared.linear[side];
+                change.angular[side] += shared.angular[side];
+            }
+        }
+        Some(change)
     }
 
     /// Not applied (`None`) where it would give the moving body kinetic energy: held

@@ -89,6 +89,10 @@ pub struct PreparedContact {
     /// The sliding velocity (contact space, x = 0) right after the pick that saturated the
     /// contact; meaningful only while `friction_saturated`.
     pub saturated_sliding: Vec3,
+    /// How many times this step's picks have shared the friction of this contact's manifold by
+    /// load ([`super::velocity::share_manifold_friction`], which does so a bounded number of
+    /// times a step).
+    pub friction_shared: u8,
     /// Penetration (m, ≥ 0) this contact's own picks have resolved so far this step: the sum
     /// of their projection depths. A pick may take back part of it, never more
     /// ([`super::position::projection_depth`]): the position pass's accumulated clamp, as the
@@ -150,6 +154,7 @@ impl PreparedContact {
             impulse: Vec3::ZERO,
             friction_saturated: false,
             saturated_sliding: Vec3::ZERO,
+            friction_shared: 0,
             projected: 0.0,
             held: false,
         }
@@ -388,6 +393,7 @@ pub fn prepare(
         impulse: Vec3::ZERO,
         friction_saturated: false,
         saturated_sliding: Vec3::ZERO,
+        friction_shared: 0,
         projected: 0.0,
         held: false,
     })
