@@ -32,6 +32,16 @@ impl BodyChange {
         angular: [Vec3::ZERO; 2],
     };
 
+    /// Adds `other`, a change of the same two bodies, side by side.
+    #[inline]
+    pub fn add(&mut self, other: &BodyChange) {
+        debug_assert_eq!(self.body, other.body, "changes of different bodies");
+        for side in 0..2 {
+            self.linear[side] += other.linear[side];
+            self.angular[side] += other.angular[side];
+        }
+    }
+
     /// The change of the material point at lever arm `r` of body `body`, summed over the
     /// sides that changed it (a contact may touch the same body twice only in degenerate
     /// input, where summing is still the right answer). `None` when `body` is unchanged.

@@ -124,11 +124,7 @@ impl Pass for VelocityPass<'_> {
             )
         {
             // The same two bodies: the picked contact is one of the manifold's points.
-            debug_assert_eq!(shared.body, change.body, "a manifold of another pair");
-            for side in 0..2 {
-                change.linear[side] += shared.linear[side];
-                change.angular[side] += shared.angular[side];
-            }
+            change.add(&shared);
         }
         Some(change)
     }
