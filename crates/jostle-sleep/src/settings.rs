@@ -28,7 +28,8 @@ pub struct SleepSettings {
     /// than its friction angle, a box on a moving belt. A body at rest jitters about its
     /// place, slowly, and its velocities average away. A body speeding up from rest at less
     /// than about 0.05 m/s² still qualifies once its motion has decayed (1 s after it was
-    /// added or woken) and is stopped.
+    /// added or woken) and is stopped. Each mean is capped at ten times this (as the motion is
+    /// at 10·ε), so that a fall is forgotten within about 2 s of the landing.
     pub drift_threshold: f32,
 }
 

@@ -137,7 +137,8 @@ pub struct SoftStepSettings {
     pub push_out_rate: f32,
     /// Gauss-Seidel sweeps over a manifold's normal rows per pass with rigid contacts, and in
     /// the biased pass of soft contacts at an impact (a point of the batch approaching faster
-    /// than gravity can make it within the step, |g|·dt, at the start of the step) (count).
+    /// than gravity can make it within the step, |g|·dt, at the start of the step, or its
+    /// bodies approaching that fast in the substep, or parting that fast under load) (count).
     /// Default 8. The points of a face share their load through the bodies' rotation, and one
     /// sweep leaves most of that coupling unsolved: a column of 40 boxes falls with 4 sweeps
     /// and stands with 8 (rigid contacts), and a unit box landing flat at 50 m/s on soft

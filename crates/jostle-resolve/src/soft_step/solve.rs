@@ -1050,7 +1050,8 @@ pub struct BiasedPass {
     /// Sweeps over a manifold's normal rows ([`super::SoftStepSettings::normal_sweeps`]):
     /// every manifold's with rigid contacts; with soft ones, those of a manifold (a lane of
     /// its batch) that no direct island solves and where some point approached faster than
-    /// `impact_speed` at the start of the step (`solve_batch_split`).
+    /// `impact_speed` at the start of the step, or the bodies approach that fast now or part
+    /// that fast under load (`solve_batch_split`, `impacts_now`).
     pub sweeps: u32,
     /// Approach speed (m/s) at the start of the step beyond which a contact is an impact:
     /// |g|·dt, the most that gravity adds in a step (a resting contact approaches at a
@@ -1262,7 +1263,8 @@ fn solve_batch_split<F: Lane, L: LinearResponse<F>>(
     // a resting one beside a landing one keeps its single sweep).
     let none = F::ZERO.cmplt(F::ZERO);
     let impacts = if pass.sweeps > 1 {
-        impacts(points, F::splat(-pass.impact_speed))
+        let below = F::splat(-pass.impact_speed);
+        impacts(points, below) | impacts_now(pair, points, below)
     } else {
         none
     };
@@ -1342,6 +1344,33 @@ fn impacts<F: Lane>(points: &[PointLanes<F>], below: F) -> F::Mask {
     points
         .iter()
         .fold(none, |any, p| any | p.relative_velocity.cmplt(below))
+}
+
+/// The lanes of `points` whose bodies approach faster than `-below` (m/s; `below` ≤ 0) now,
+/// along the first point's normal, or part that fast while some point carries an impulse:
+/// an impact that began within the step (a box landing on one that rests passes its momentum
+/// on to the ground in a later substep), or the one before it carried on by the warm start,
+/// which applies every substep's accumulated impulses again (the biased pass then takes most
+/// of them back). Either asks for more than one sweep of the rows as the start-of-step
+/// approach does ([`impacts`]): solved once, in order, the first point takes the change, turns
+/// the bodies and leaves a face's other points a different one (benches/RESULTS.md, "A
+/// landing passed on lands flat"). Bodies' linear velocities only: this is for the pair's
+/// whole approach, which the start-of-step test already catches for a turning body.
+#[inline(always)]
+fn impacts_now<F: Lane, L: LinearResponse<F>>(
+    pair: &Pair<F, L>,
+    points: &[PointLanes<F>],
+    below: F,
+) -> F::Mask {
+    let none = F::ZERO.cmplt(F::ZERO);
+    let Some(first) = points.first() else {
+        return none;
+    };
+    let approach = (pair.a.linear - pair.b.linear).dot(first.normal);
+    let loaded = points
+        .iter()
+        .fold(none, |any, p| any | p.normal_impulse.cmpgt(F::ZERO));
+    approach.cmplt(below) | (loaded & (F::ZERO - approach).cmplt(below))
 }
 
 #[inline(always)]
