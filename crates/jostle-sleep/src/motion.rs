@@ -24,8 +24,8 @@ pub fn update_motion(body: &mut RigidBody, settings: &SleepSettings, dt: f32, mo
     body.sleep.motion = motion.min(10.0 * settings.threshold);
     let mean = |old: jostle_math::Vec3, now: jostle_math::Vec3| bias * old + (1.0 - bias) * now;
     // Each mean is capped, as the motion is, at ten times its threshold: a mean that remembered
-    // a fall at its full speed kept a box dropped 5 m awake 5.8 s after it landed (its mean
-    // velocity halving each second from 8 m/s), and every box of a dropped lattice until 8 s.
+    // a fall kept a box dropped 5 m awake 5.8 s after it landed (its mean velocity, 2.8 m/s at
+    // the landing, halving each second), and every box of a dropped lattice until 8.1 s.
     let cap = 10.0 * settings.drift_threshold;
     let capped = |m: jostle_math::Vec3, scale: f32| {
         let size = m.length_squared() * scale;
