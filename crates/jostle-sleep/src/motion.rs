@@ -8,7 +8,7 @@ use jostle_body::RigidBody;
 /// for sleep: motion ← bias·motion + (1 − bias)·max(|v|² + |ω|², moved) with bias = base^dt,
 /// capped at 10·ε, and the mean velocities v̄ ← bias·v̄ + (1 − bias)·v (ω̄ the same), capped
 /// at |v̄|² ≤ 10·`drift_threshold` (and r²·|ω̄|², r the radius of gyration);
-/// qualifies when motion < ε, both |v̄|² + r²·|ω̄|² (r the radius of gyration) and |v|² are
+/// qualifies when motion < ε, both |v̄|² + r²·|ω̄|² and |v|² are
 /// below `drift_threshold`, and the body may sleep (a body moving or spinning steadily has a
 /// mean velocity, one speeding up from rest a velocity ahead of its mean; one at rest jitters
 /// or rocks about its place, slowly, and its mean is none). `moved` is the square of how fast
