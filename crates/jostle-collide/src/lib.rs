@@ -21,6 +21,7 @@ pub mod groups;
 pub mod mass;
 pub mod material;
 pub mod narrow_phase;
+mod polytope;
 pub mod query;
 pub mod reduce;
 pub mod settings;

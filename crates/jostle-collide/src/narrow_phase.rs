@@ -21,6 +21,7 @@
 use crate::broad_phase::ColliderPair;
 use crate::collider::{Collider, ColliderHandle, ColliderSet};
 use crate::material::Material;
+use crate::polytope;
 use crate::reduce::reduce_manifold;
 use crate::settings::CollideSettings;
 use crate::shape::MAX_EXTENT;
@@ -1754,8 +1755,9 @@ fn compute(
 
 /// parry's contact manifolds of `c1` and `c2` at `pos12` (`c2`'s pose in `c1`'s frame),
 /// updated in `manifolds` from what they hold: small shapes clipped scaled up
-/// ([`clip_scale`]), with the pair's scaled copies of hulls and compounds kept in `scaled`.
-/// An error for an unsupported pair of shapes.
+/// ([`clip_scale`]), with the pair's scaled copies of hulls and compounds kept in `scaled`;
+/// a pair of flat-faced shapes' answer checked against their faces' axes
+/// ([`polytope::check`]). An error for an unsupported pair of shapes.
 fn query(
     pos12: &Pose,
     c1: &Collider,
@@ -1789,7 +1791,9 @@ fn query(
     }
     if scale == 1.0 {
         DefaultQueryDispatcher
-            .contact_manifolds(pos12, shape1, shape2, prediction, manifolds, workspace)
+            .contact_manifolds(pos12, shape1, shape2, prediction, manifolds, workspace)?;
+        polytope::check(pos12, shape1, shape2, prediction, manifolds);
+        Ok(())
     } else {
         // Small shapes are clipped scaled up, their points scaled back.
         let scaled_pose = Pose::from_parts(pos12.translation * scale, pos12.rotation);
@@ -1809,6 +1813,15 @@ fn query(
             manifolds,
             workspace,
         );
+        if result.is_ok() {
+            polytope::check(
+                &scaled_pose,
+                scaled1,
+                scaled2,
+                prediction * scale,
+                manifolds,
+            );
+        }
         scale_manifolds(manifolds, scale.recip());
         result
     }
@@ -1843,7 +1856,9 @@ const MISSED_DEPTH: f32 = 1e-2;
 /// touching, parry answered with one point and a sideways normal (a 7.5 mm hull cube on
 /// another, normal along z; coins the same), and checked only where parry kept a manifold, a
 /// column of five such cubes moved 1.8 mm before it was caught. Computed again (from the
-/// manifold's points, `mark_shapes_deformed`), the answer is the face's four points.
+/// manifold's points, `mark_shapes_deformed`), the answer is the face's four points. (For
+/// hulls and cylinders that are no compound's parts, [`polytope::check`] now catches such
+/// answers first, in [`query`].)
 fn misses_a_deeper_point(m: &Manifold, c1: &Collider, c2: &Collider, pos12: &Pose) -> bool {
     if m.points.is_empty() {
         return false;
