@@ -1674,7 +1674,7 @@ fn relative_pose((t1, r1): (Vec3, Quat), (t2, r2): (Vec3, Quat)) -> Pose {
 }
 
 /// The relative pose of a manifold's two sub-shapes (compound parts carry their own frames).
-fn manifold_pos12(m: &Manifold, pos12: &Pose) -> Pose {
+pub(crate) fn manifold_pos12<D>(m: &ContactManifold<(), D>, pos12: &Pose) -> Pose {
     if m.subshape_pos1().is_none() && m.subshape_pos2().is_none() {
         return *pos12;
     }
@@ -1856,9 +1856,8 @@ const MISSED_DEPTH: f32 = 1e-2;
 /// touching, parry answered with one point and a sideways normal (a 7.5 mm hull cube on
 /// another, normal along z; coins the same), and checked only where parry kept a manifold, a
 /// column of five such cubes moved 1.8 mm before it was caught. Computed again (from the
-/// manifold's points, `mark_shapes_deformed`), the answer is the face's four points. (For
-/// hulls and cylinders that are no compound's parts, [`polytope::check`] now catches such
-/// answers first, in [`query`].)
+/// manifold's points, `mark_shapes_deformed`), the answer is the face's four points.
+/// ([`polytope::check`] now catches such answers first, in [`query`].)
 fn misses_a_deeper_point(m: &Manifold, c1: &Collider, c2: &Collider, pos12: &Pose) -> bool {
     if m.points.is_empty() {
         return false;

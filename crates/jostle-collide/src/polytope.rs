@@ -1,5 +1,5 @@
 //! Contacts of flat-faced convex shapes (convex hulls; a hull or a cylinder with a box or a
-//! cylinder) checked against the separating axes of their faces.
+//! cylinder; also as compounds' parts) checked against the separating axes of their faces.
 //!
 //! parry 0.31 finds the contact of two such shapes from the closest points of its GJK (or its
 //! EPA's deepest penetration), whose direction is the rounding error of the difference of two
@@ -9,7 +9,8 @@
 //! 0.1° about the vertical, four points along a normal 35° off it; coins the same. A stack of
 //! hulls built touching, or resting at the solver's slop, then has its contacts missing or
 //! pointing sideways (a column of five 7.5 mm hull cubes fell 13 mm into itself before their
-//! contacts appeared). Two boxes are unaffected: parry separates them by their faces' axes.
+//! contacts appeared). Compounds of such shapes the same, part by part. Two boxes are
+//! unaffected: parry separates them by their faces' axes; so are shapes on a triangle mesh.
 //!
 //! [`check`] keeps parry's answer unless it contradicts what the shapes' support points prove
 //! (the distance of two convex shapes is at least their gap along any axis): no contact where
@@ -23,12 +24,13 @@
 //! line of centres is looked at first (two support points), so a sound answer costs four
 //! support points and the faces are scanned only for suspect ones.
 
+use crate::narrow_phase::manifold_pos12;
 use jostle_math::Vec3;
 use parry3d::math::Pose;
 use parry3d::query::ContactManifold;
 use parry3d::shape::{
-    ConvexPolyhedron, Cuboid, Cylinder, PolygonalFeature, PolygonalFeatureMap, Shape, ShapeType,
-    SupportMap,
+    Compound, ConvexPolyhedron, Cuboid, Cylinder, PolygonalFeature, PolygonalFeatureMap, Shape,
+    ShapeType, SupportMap,
 };
 
 /// A convex shape with flat faces whose normals parry lists (a cylinder's two caps).
@@ -123,10 +125,10 @@ fn best_face_axis(p1: Polytope, p2: Polytope, pos12: &Pose) -> (Vec3, f32) {
 /// centimetres off what the support points show or a missing contact.
 const AGREEMENT: f32 = 0.05;
 
-/// Checks parry's contact manifolds of two convex shapes at `pos12` (shape 2's pose in shape
-/// 1's frame) against the separating axes of their faces, and replaces them with the contact
-/// along the best face axis where they contradict it (see the module's header). Does nothing
-/// unless both shapes are polytopes and not both boxes.
+/// Checks parry's contact manifolds of two shapes at `pos12` (shape 2's pose in shape 1's
+/// frame) against the separating axes of their faces, and corrects them where they contradict
+/// them (see the module's header): the pair's one manifold for two convex shapes, each part
+/// pair's for compounds. Pairs that are not both polytopes, and two boxes, are left alone.
 pub(crate) fn check<D: Default + Copy>(
     pos12: &Pose,
     shape1: &dyn Shape,
@@ -134,17 +136,91 @@ pub(crate) fn check<D: Default + Copy>(
     prediction: f32,
     manifolds: &mut Vec<ContactManifold<(), D>>,
 ) {
-    let (Some(p1), Some(p2)) = (Polytope::of(shape1), Polytope::of(shape2)) else {
+    let compounds = (compound(shape1), compound(shape2));
+    if compounds.0.is_none() && compounds.1.is_none() {
+        if manifolds.len() > 1 {
+            return;
+        }
+        let (Some(p1), Some(p2)) = (Polytope::of(shape1), Polytope::of(shape2)) else {
+            return;
+        };
+        match verdict(pos12, p1, p2, prediction, manifolds.first()) {
+            Verdict::Keep => {}
+            Verdict::Clear => manifolds.iter_mut().for_each(|m| m.points.clear()),
+            Verdict::Replace(face) => {
+                manifolds.clear();
+                manifolds.push(face);
+            }
+        }
         return;
-    };
-    if matches!((p1, p2), (Polytope::Cuboid(_), Polytope::Cuboid(_))) || manifolds.len() > 1 {
-        return;
+    }
+    for m in manifolds.iter_mut() {
+        let (Some(part1), Some(part2)) = (
+            part(compounds.0, shape1, m.subshape1).and_then(Polytope::of),
+            part(compounds.1, shape2, m.subshape2).and_then(Polytope::of),
+        ) else {
+            continue;
+        };
+        let pose = manifold_pos12(m, pos12);
+        match verdict(&pose, part1, part2, prediction, Some(m)) {
+            Verdict::Keep => {}
+            Verdict::Clear => m.points.clear(),
+            Verdict::Replace(face) => {
+                // The part pair's manifold keeps its parts and their poses.
+                m.points = face.points;
+                m.local_n1 = face.local_n1;
+                m.local_n2 = face.local_n2;
+            }
+        }
+    }
+}
+
+/// `shape` as a compound, if it is one.
+fn compound(shape: &dyn Shape) -> Option<&Compound> {
+    match shape.shape_type() {
+        ShapeType::Compound => shape.as_compound(),
+        _ => None,
+    }
+}
+
+/// Part `index` of `compound`, or `whole` where the shape is no compound.
+fn part<'a>(
+    compound: Option<&'a Compound>,
+    whole: &'a dyn Shape,
+    index: u32,
+) -> Option<&'a dyn Shape> {
+    match compound {
+        Some(c) => c.shapes().get(index as usize).map(|(_, part)| &*part.0),
+        None => Some(whole),
+    }
+}
+
+/// What [`check`] does with parry's answer for one pair of convex shapes.
+enum Verdict<D> {
+    /// The answer agrees with the support points.
+    Keep,
+    /// A face axis separates the shapes by more than the prediction distance.
+    Clear,
+    /// The contact along the best face axis, in place of a contradicted answer.
+    Replace(ContactManifold<(), D>),
+}
+
+/// The [`Verdict`] on parry's `answer` for two polytopes at `pos12` (`None`: no manifold).
+fn verdict<D: Default + Copy>(
+    pos12: &Pose,
+    p1: Polytope,
+    p2: Polytope,
+    prediction: f32,
+    answer: Option<&ContactManifold<(), D>>,
+) -> Verdict<D> {
+    if matches!((p1, p2), (Polytope::Cuboid(_), Polytope::Cuboid(_))) {
+        return Verdict::Keep;
     }
     let (s1, s2) = (p1.support(), p2.support());
     let tolerance = AGREEMENT * p1.size().min(p2.size());
     // parry's answer: its closest point's distance, and whether the shapes lie along its
     // normal as that distance says.
-    let answer = manifolds.first().filter(|m| !m.points.is_empty()).map(|m| {
+    let answer = answer.filter(|m| !m.points.is_empty()).map(|m| {
         let closest = m.points.iter().map(|p| p.dist).fold(f32::MAX, f32::min);
         let consistent = m
             .local_n1
@@ -158,22 +234,19 @@ pub(crate) fn check<D: Default + Copy>(
     let centres = pos12.translation.try_normalize().unwrap_or(Vec3::Y);
     let gap_centres = separation(s1, s2, pos12, centres);
     match answer {
-        Some((closest, true)) if closest >= gap_centres - tolerance => return,
-        None if gap_centres > prediction => return,
+        Some((closest, true)) if closest >= gap_centres - tolerance => return Verdict::Keep,
+        None if gap_centres > prediction => return Verdict::Keep,
         _ => {}
     }
     let (axis, gap) = best_face_axis(p1, p2, pos12);
     if gap > prediction {
         // Apart along a face axis: no contact, whatever was answered.
-        if let Some(m) = manifolds.first_mut() {
-            m.points.clear();
-        }
-        return;
+        return Verdict::Clear;
     }
     if let Some((closest, true)) = answer
         && closest >= gap - tolerance
     {
-        return;
+        return Verdict::Keep;
     }
     let mut face = ContactManifold::<(), D>::with_data(0, 0, ());
     let mut feature1 = PolygonalFeature::default();
@@ -196,10 +269,9 @@ pub(crate) fn check<D: Default + Copy>(
     if (closest - gap).abs() > tolerance {
         // The features do not overlap along the axis (shapes corner to corner, say), or not
         // where the shapes come closest: parry's answer stands.
-        return;
+        return Verdict::Keep;
     }
     face.local_n1 = axis;
     face.local_n2 = axis2;
-    manifolds.clear();
-    manifolds.push(face);
+    Verdict::Replace(face)
 }
