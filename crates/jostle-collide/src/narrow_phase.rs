@@ -1756,7 +1756,7 @@ fn compute(
 /// parry's contact manifolds of `c1` and `c2` at `pos12` (`c2`'s pose in `c1`'s frame),
 /// updated in `manifolds` from what they hold: small shapes clipped scaled up
 /// ([`clip_scale`]), with the pair's scaled copies of hulls and compounds kept in `scaled`;
-/// a pair of flat-faced shapes' answer checked against their faces' axes
+/// a pair of flat-faced shapes' answer checked against their separating axes
 /// ([`polytope::check`]). An error for an unsupported pair of shapes.
 fn query(
     pos12: &Pose,

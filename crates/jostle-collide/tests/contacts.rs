@@ -657,3 +657,84 @@ fn flat_faces_within_micrometres_of_touching_touch_face_to_face() {
         failures.join("\n")
     );
 }
+
+/// Cubes (convex hulls, boxes, one of each) meeting edge across edge within a few micrometres
+/// of touching: the lower turned 45° about z, the upper 45° about x, their edges crossing at
+/// right angles; apart, touching or overlapping by up to 10⁻⁴ of their half size, inserted in
+/// either order. The contact's normal is the vertical (the edges' common perpendicular) and its
+/// deepest point is as deep as the cubes overlap. With a hull in the pair, parry 0.31 got 38 of
+/// these 224 cases wrong (normals as far as 90° off the vertical), and so did the narrow
+/// phase's check while it tried face normals only; it now tries the edges' cross products too.
+#[test]
+fn cubes_meeting_edge_across_edge_touch_along_the_common_perpendicular() {
+    let hull = |h: f32| {
+        let corners = (0..8)
+            .map(|i| {
+                let sign = |bit: u32| if i & bit == 0 { -h } else { h };
+                Vec3::new(sign(1), sign(2), sign(4))
+            })
+            .collect();
+        ShapeDesc::ConvexHull { points: corners }
+    };
+    let cube = |h: f32| ShapeDesc::Cuboid {
+        half_extents: Vec3::splat(h),
+    };
+    let mut failures = Vec::new();
+    let mut cases = 0;
+    for h in [0.0075f32, 0.05, 0.5, 5.0] {
+        let pairs = [
+            (hull(h), hull(h)),
+            (cube(h), hull(h)),
+            (hull(h), cube(h)),
+            (cube(h), cube(h)),
+        ];
+        for (lower, upper) in &pairs {
+            for gap in [-1e-4f32, -1e-5, -1e-6, 0.0, 1e-6, 1e-5, 1e-4] {
+                for lower_first in [true, false] {
+                    cases += 1;
+                    let mut scene = Scene::new();
+                    let turn_lower = Quat::from_rotation_z(std::f32::consts::FRAC_PI_4);
+                    let turn_upper = Quat::from_rotation_x(std::f32::consts::FRAC_PI_4);
+                    // Each cube's edge reaches √2·h from its centre.
+                    let position = Vec3::Y * (2.0 * std::f32::consts::SQRT_2 * h + gap * h);
+                    let upper_body = if lower_first {
+                        scene.add(lower, Vec3::ZERO, turn_lower, false);
+                        scene.add(upper, position, turn_upper, false).0
+                    } else {
+                        let u = scene.add(upper, position, turn_upper, false).0;
+                        scene.add(lower, Vec3::ZERO, turn_lower, false);
+                        u
+                    };
+                    scene.step();
+                    let contacts = scene.contacts();
+                    let deepest = contacts
+                        .iter()
+                        .map(|c| c.penetration)
+                        .fold(f32::NEG_INFINITY, f32::max);
+                    let sideways = contacts.iter().any(|c| {
+                        let up = if c.a == upper_body { Vec3::Y } else { -Vec3::Y };
+                        c.normal.dot(up) < 0.9998
+                    });
+                    if sideways || (deepest + gap * h).abs() > 1e-5 * h.max(0.01) {
+                        failures.push(format!(
+                            "{} on {}, half size {h}, gap {gap}·h, lower first {lower_first}: \
+                             {:?}",
+                            upper.kind(),
+                            lower.kind(),
+                            contacts
+                                .iter()
+                                .map(|c| (c.normal, c.penetration))
+                                .collect::<Vec<_>>()
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {cases}:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
