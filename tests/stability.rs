@@ -465,6 +465,17 @@ fn stack_from(
     (sideways, tilt)
 }
 
+/// A cube of half size `h` as a convex hull of its corners, in a scene file's words.
+fn hull_cube_ron(h: f32) -> String {
+    let corners: Vec<String> = (0..8)
+        .map(|i| {
+            let sign = |bit: u32| if i & bit == 0 { -h } else { h };
+            format!("({}, {}, {})", sign(1), sign(2), sign(4))
+        })
+        .collect();
+    format!("ConvexHull(points: [{}])", corners.join(", "))
+}
+
 /// Boxes (also as convex hulls and compounds) and coins of 5 mm to 4 cm stand in stacks, from
 /// an exact start and from 0.1 mm gaps:
 /// no body moves sideways by a fifth of its largest half size or ends tilted by 1°. Two equal
@@ -476,15 +487,7 @@ fn stack_from(
 fn small_boxes_and_coins_stand_in_stacks() {
     let cube = |h: f32| format!("Cuboid(half_extents: ({h}, {h}, {h}))");
     let coin = |r: f32, h: f32| format!("Cylinder(half_height: {h}, radius: {r})");
-    let hull = |h: f32| {
-        let corners: Vec<String> = (0..8)
-            .map(|i| {
-                let sign = |bit: u32| if i & bit == 0 { -h } else { h };
-                format!("({}, {}, {})", sign(1), sign(2), sign(4))
-            })
-            .collect();
-        format!("ConvexHull(points: [{}])", corners.join(", "))
-    };
+    let hull = hull_cube_ron;
     let compound = |h: f32| format!("Compound(parts: [CompoundPart(shape: {})])", cube(h));
     // (shape, half height, largest half size, count)
     let mut cases = Vec::new();
@@ -533,18 +536,11 @@ fn small_boxes_and_coins_stand_in_stacks() {
 /// sideways by up to 2·10⁻⁴ of its half size (seeded): none moves sideways by 5% of its half
 /// size or ends tilted by 0.1°. parry's contacts of two hulls within a micrometre of touching
 /// had sideways or diagonal normals, or none, and 20 of these 72 columns ended more than 5% of
-/// a half size aside or tilted (six fell over) (benches/RESULTS.md, "Hulls within a micrometre of touching").
+/// a half size aside or tilted (six fell over; benches/RESULTS.md, "Hulls within a micrometre
+/// of touching").
 #[test]
 fn convex_hull_columns_built_touching_stand() {
-    let hull = |h: f32| {
-        let corners: Vec<String> = (0..8)
-            .map(|i| {
-                let sign = |bit: u32| if i & bit == 0 { -h } else { h };
-                format!("({}, {}, {})", sign(1), sign(2), sign(4))
-            })
-            .collect();
-        format!("ConvexHull(points: [{}])", corners.join(", "))
-    };
+    let hull = hull_cube_ron;
     let mut rng = 0x9e37_79b9_u32;
     let mut unit = move || {
         rng ^= rng << 13;

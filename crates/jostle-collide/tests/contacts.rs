@@ -431,12 +431,6 @@ fn equal_boxes_face_to_face_touch_at_four_corners_at_any_size() {
         let box_ = ShapeDesc::Cuboid {
             half_extents: Vec3::splat(half),
         };
-        let corners = (0..8)
-            .map(|i| {
-                let sign = |bit: u32| if i & bit == 0 { -half } else { half };
-                Vec3::new(sign(1), sign(2), sign(4))
-            })
-            .collect();
         let compound = ShapeDesc::Compound {
             parts: vec![jostle_collide::CompoundPart {
                 shape: box_.clone(),
@@ -444,7 +438,7 @@ fn equal_boxes_face_to_face_touch_at_four_corners_at_any_size() {
                 rotation: Quat::IDENTITY,
             }],
         };
-        [box_, ShapeDesc::ConvexHull { points: corners }, compound]
+        [box_, hull_cube(half), compound]
     };
     for half in [0.0025, 0.005, 0.0075, 0.02, 0.05, 0.1, 0.5, 2.0, 10.0] {
         for cube in shapes(half).iter().cycle().take(9) {
@@ -552,15 +546,7 @@ fn a_box_turned_down_about_an_edge_reports_its_far_edge_deep() {
 /// parts.
 #[test]
 fn flat_faces_within_micrometres_of_touching_touch_face_to_face() {
-    let hull = |h: f32| {
-        let corners = (0..8)
-            .map(|i| {
-                let sign = |bit: u32| if i & bit == 0 { -h } else { h };
-                Vec3::new(sign(1), sign(2), sign(4))
-            })
-            .collect();
-        ShapeDesc::ConvexHull { points: corners }
-    };
+    let hull = hull_cube;
     let cube = |h: f32| ShapeDesc::Cuboid {
         half_extents: Vec3::splat(h),
     };
@@ -650,12 +636,7 @@ fn flat_faces_within_micrometres_of_touching_touch_face_to_face() {
             }
         }
     }
-    assert!(
-        failures.is_empty(),
-        "{} of {cases}:\n{}",
-        failures.len(),
-        failures.join("\n")
-    );
+    assert_none_failed(&failures, cases);
 }
 
 /// Cubes (convex hulls, boxes, one of each) meeting edge across edge within a few micrometres
@@ -667,15 +648,7 @@ fn flat_faces_within_micrometres_of_touching_touch_face_to_face() {
 /// phase's check while it tried face normals only; it now tries the edges' cross products too.
 #[test]
 fn cubes_meeting_edge_across_edge_touch_along_the_common_perpendicular() {
-    let hull = |h: f32| {
-        let corners = (0..8)
-            .map(|i| {
-                let sign = |bit: u32| if i & bit == 0 { -h } else { h };
-                Vec3::new(sign(1), sign(2), sign(4))
-            })
-            .collect();
-        ShapeDesc::ConvexHull { points: corners }
-    };
+    let hull = hull_cube;
     let cube = |h: f32| ShapeDesc::Cuboid {
         half_extents: Vec3::splat(h),
     };
@@ -731,6 +704,11 @@ fn cubes_meeting_edge_across_edge_touch_along_the_common_perpendicular() {
             }
         }
     }
+    assert_none_failed(&failures, cases);
+}
+
+/// Fails with every case that `failures` describes, out of `cases`.
+fn assert_none_failed(failures: &[String], cases: usize) {
     assert!(
         failures.is_empty(),
         "{} of {cases}:\n{}",

@@ -113,3 +113,14 @@ pub fn mesh_floor() -> ShapeDesc {
         indices: vec![[0, 2, 1], [0, 3, 2]],
     }
 }
+
+/// A cube of half size `h` as the convex hull of its eight corners.
+pub fn hull_cube(h: f32) -> ShapeDesc {
+    let corners = (0..8)
+        .map(|i| {
+            let sign = |bit: u32| if i & bit == 0 { -h } else { h };
+            Vec3::new(sign(1), sign(2), sign(4))
+        })
+        .collect();
+    ShapeDesc::ConvexHull { points: corners }
+}
