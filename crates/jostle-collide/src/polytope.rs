@@ -208,8 +208,8 @@ const EDGE_MARGIN: f32 = 1e-3;
 const AGREEMENT: f32 = 0.05;
 
 /// Checks parry's contact manifolds of two shapes at `pos12` (shape 2's pose in shape 1's
-/// frame) against their separating axes ([`best_axis`]), and corrects them where they contradict
-/// them (see the module's header): the pair's one manifold for two convex shapes, each part
+/// frame) against their separating axes ([`best_face_axis`], [`best_edge_axis`]), and corrects
+/// them where they contradict them (see the module's header): the pair's one manifold for two convex shapes, each part
 /// pair's for compounds. Pairs that are not both polytopes, and two boxes, are left alone.
 pub(crate) fn check<D: Default + Copy>(
     pos12: &Pose,
