@@ -2082,9 +2082,7 @@ fn scaled_shape(shape: &dyn Shape, scale: f32) -> Option<SharedShape> {
 fn gap_along(c1: &Collider, c2: &Collider, pos12: &Pose, axis: Vec3) -> Option<f32> {
     let s1 = c1.shape.as_support_map()?;
     let s2 = c2.shape.as_support_map()?;
-    let far1 = axis.dot(s1.local_support_point(axis));
-    let near2 = axis.dot(s2.support_point(pos12, -axis));
-    Some(near2 - far1)
+    Some(polytope::separation(s1, s2, pos12, axis))
 }
 
 /// How much further apart than the prediction distance a pair's shapes must lie along its

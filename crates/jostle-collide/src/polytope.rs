@@ -109,7 +109,12 @@ impl<'a> Polytope<'a> {
 
 /// How far apart shape 2 lies from shape 1 along the unit direction `axis` of shape 1's frame
 /// (negative: overlap along it), with shape 2 at `pos12`.
-fn separation(s1: &dyn SupportMap, s2: &dyn SupportMap, pos12: &Pose, axis: Vec3) -> f32 {
+pub(crate) fn separation(
+    s1: &dyn SupportMap,
+    s2: &dyn SupportMap,
+    pos12: &Pose,
+    axis: Vec3,
+) -> f32 {
     axis.dot(s2.support_point(pos12, -axis)) - axis.dot(s1.local_support_point(axis))
 }
 
