@@ -348,7 +348,9 @@ fn load_compensation_removes_the_load_proportional_sink() {
 /// sweep of heavy boxes on light ones (`family::heavy_sweep`) instead of the family,
 /// `FAMILY_SET=heavy_seeds` the same from many more seeds (`family::heavy_seeds`),
 /// `FAMILY_SET=tall` the tall members' variations (`family::tall_variations`),
-/// `FAMILY_SET=small` the members of 5 mm to 5 cm boxes (`family::small`).
+/// `FAMILY_SET=small` the members of 5 mm to 5 cm boxes (`family::small`), and
+/// `FAMILY_SET=large` the 10 m members from perturbed starts (`family::large_perturbed`), from
+/// seeds 31 and 32 or from those listed in `FAMILY_LARGE_SEEDS` (`33,34,35`).
 #[test]
 #[ignore = "a measurement of several minutes in release; run with --ignored --nocapture"]
 fn family_table() {
