@@ -531,6 +531,51 @@ fn small_boxes_and_coins_stand_in_stacks() {
     }
 }
 
+/// Single small cylinders, boxes and hulls of 0.5 to 5 mm resting flat on the ground from an
+/// exact start stay put for 10 s: none moves sideways by 5% of its largest half size or ends
+/// tilted by 1°. While a held contact frame's lever arms were kept within 4 mm at any size,
+/// every cylinder of 2 mm radius or less spun up from rest: parry's points on its face turn
+/// around the rim with the direction of the slightest tilt, the held points kept their old
+/// places and took the new points' depths, and the tilt grew 1.5 times a step until the
+/// cylinder rolled away (a disc of 2 mm radius and 1 mm half height: 0.53 m in 10 s, 35 rad/s;
+/// benches/RESULTS.md, "Held frames in proportion to the body").
+#[test]
+fn small_shapes_resting_flat_stay_put() {
+    let mut cases = Vec::new();
+    for r in [0.0005f32, 0.001, 0.002, 0.003, 0.005] {
+        for ratio in [0.25f32, 0.5, 2.0] {
+            let h = r * ratio;
+            cases.push((
+                format!("Cylinder(half_height: {h}, radius: {r})"),
+                h,
+                r.max(h),
+            ));
+        }
+    }
+    for h in [0.0005f32, 0.001, 0.0025] {
+        cases.push((
+            format!("Cuboid(half_extents: ({h}, {}, {h}))", 0.5 * h),
+            0.5 * h,
+            h,
+        ));
+        cases.push((hull_cube_ron(h), h, h));
+    }
+    let mut wrong = Vec::new();
+    for (shape, half, size) in &cases {
+        let (sideways, tilt) = small_stack(shape, *half, 1, 0.0);
+        let what = format!(
+            "{shape}: {:.3} half sizes aside, tilted {:.2}°",
+            sideways / size,
+            tilt.to_degrees()
+        );
+        println!("{what}");
+        if !(sideways < 0.05 * size && tilt < 1f32.to_radians()) {
+            wrong.push(what);
+        }
+    }
+    assert!(wrong.is_empty(), "{wrong:#?}");
+}
+
 /// Columns of 5 and 10 convex-hull cubes of 5 cm to 0.5 m built touching, as hulls and as
 /// compounds of one hull, from an exact start and from five starts with each cube moved
 /// sideways by up to 2·10⁻⁴ of its half size (seeded): none moves sideways by 5% of its half

@@ -25,7 +25,9 @@ pub struct CollideSettings {
     ///
     /// A contact point that persists (same features) keeps the normal and the two lever arms
     /// (its offsets from each body's centre of mass, in world space) it had when they were
-    /// last taken, until either lever arm has moved more than this or the normal has turned
+    /// last taken, until either lever arm has moved more than this, or more than 5% of the
+    /// smaller collider's reach radius ([`crate::Collider::reach_radius`]: bodies smaller than
+    /// about 0.1 m hold their frames in proportion to their size), or the normal has turned
     /// more than `frame_angle_tolerance`; then they are taken again. Contact forces that do
     /// not turn with small sways of the bodies do not feed those sways (a tall column whose
     /// contacts follow every tilt leans further under its own weight, see the `jostle`
