@@ -20,6 +20,7 @@ pub mod display;
 pub mod groups;
 pub mod mass;
 pub mod material;
+mod mesh_patch;
 pub mod narrow_phase;
 mod polytope;
 pub mod query;

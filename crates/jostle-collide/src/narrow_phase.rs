@@ -1812,6 +1812,7 @@ fn query(
         DefaultQueryDispatcher
             .contact_manifolds(pos12, shape1, shape2, prediction, manifolds, workspace)?;
         polytope::check(pos12, shape1, shape2, prediction, manifolds);
+        crate::mesh_patch::refine(pos12, shape1, shape2, prediction, manifolds);
         Ok(())
     } else {
         // Small shapes are clipped scaled up, their points scaled back.

@@ -168,12 +168,34 @@ fn contact_along<D: Default + Copy>(
     prediction: f32,
     tolerance: f32,
 ) -> Option<ContactManifold<(), D>> {
+    let contact = clip_along(p1.features(), p2.features(), pos12, axis, prediction);
+    let closest = contact
+        .points
+        .iter()
+        .map(|p| p.dist)
+        .fold(f32::MAX, f32::min);
+    if (closest - gap).abs() > tolerance {
+        return None;
+    }
+    Some(contact)
+}
+
+/// The contact of two shapes at `pos12` along the unit `axis` of shape 1's frame (from shape
+/// 1 toward shape 2): their support features along it clipped against each other with
+/// parry's clipping, the points within `prediction`, the normals the axis.
+pub(crate) fn clip_along<D: Default + Copy>(
+    f1: &dyn PolygonalFeatureMap,
+    f2: &dyn PolygonalFeatureMap,
+    pos12: &Pose,
+    axis: Vec3,
+    prediction: f32,
+) -> ContactManifold<(), D> {
     let mut contact = ContactManifold::<(), D>::with_data(0, 0, ());
     let mut feature1 = PolygonalFeature::default();
     let mut feature2 = PolygonalFeature::default();
     let axis2 = pos12.rotation.inverse() * -axis;
-    p1.features().local_support_feature(axis, &mut feature1);
-    p2.features().local_support_feature(axis2, &mut feature2);
+    f1.local_support_feature(axis, &mut feature1);
+    f2.local_support_feature(axis2, &mut feature2);
     PolygonalFeature::contacts(
         pos12,
         &pos12.inverse(),
@@ -185,17 +207,9 @@ fn contact_along<D: Default + Copy>(
         false,
     );
     contact.points.retain(|p| p.dist <= prediction);
-    let closest = contact
-        .points
-        .iter()
-        .map(|p| p.dist)
-        .fold(f32::MAX, f32::min);
-    if (closest - gap).abs() > tolerance {
-        return None;
-    }
     contact.local_n1 = axis;
     contact.local_n2 = axis2;
-    Some(contact)
+    contact
 }
 
 /// How much further apart (relative to the smaller shape's size) the shapes must lie along an
