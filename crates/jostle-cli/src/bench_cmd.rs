@@ -170,6 +170,47 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         }
     }
 
+    // Every output's path before any run: one file per scene's plot (scene names that make the
+    // same file name, "a b" and "a/b", get numbered files: the second plot overwrote the
+    // first), and none may be a scene being read (a scene file named `results.csv` in the
+    // output directory was replaced by the results and the run exited 0) or unwritable (known
+    // only after every run before).
+    let mut stems: Vec<(String, String)> = Vec::new();
+    for case in &cases {
+        if stems.iter().any(|(scene, _)| *scene == case.scene) {
+            continue;
+        }
+        let mut stem = slug(&case.scene);
+        let mut n = 2;
+        while stems.iter().any(|(_, s)| *s == stem) {
+            stem = format!("{}_{n}", slug(&case.scene));
+            n += 1;
+        }
+        stems.push((case.scene.clone(), stem));
+    }
+    let csv_path = args.out.join("results.csv");
+    let mut outputs = vec![csv_path.clone()];
+    for (_, stem) in &stems {
+        outputs.extend(plot_paths(&args.out, stem));
+    }
+    let inputs: Vec<PathBuf> = scenes.iter().map(|p| crate::run_cmd::identity(p)).collect();
+    for path in &outputs {
+        if let Some(scene) = scenes
+            .iter()
+            .zip(&inputs)
+            .find(|(_, id)| **id == crate::run_cmd::identity(path))
+        {
+            return Err(format!(
+                "--out {}: {} is the scene {} being run; choose another output directory",
+                args.out.display(),
+                path.display(),
+                scene.0.display()
+            ));
+        }
+        crate::run_cmd::writable(path)
+            .map_err(|e| format!("--out {}: cannot write: {e}", path.display()))?;
+    }
+
     let bar = ProgressBar::new(cases.len() as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {elapsed} {msg}")
@@ -215,27 +256,14 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
     }
     bar.finish_and_clear();
 
-    let csv_path = args.out.join("results.csv");
     let staged = Staged::new(&csv_path);
     std::fs::write(staged.path(), csv(&rows))
         .map_err(|e| format!("{}: cannot write: {e}", csv_path.display()))?;
     staged.commit()?;
     let mut written = vec![csv_path];
-    let mut names: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
-    names.dedup();
-    // Scene names that make the same file name ("a b", "a/b") get numbered files: the second
-    // plot overwrote the first.
-    let mut stems: Vec<String> = Vec::new();
-    for name in names {
-        let scene_rows: Vec<&Row> = rows.iter().filter(|r| r.scene == name).collect();
-        let mut stem = slug(name);
-        let mut n = 2;
-        while stems.contains(&stem) {
-            stem = format!("{}_{n}", slug(name));
-            n += 1;
-        }
-        written.extend(plot_scene(&args.out, name, &stem, &scene_rows)?);
-        stems.push(stem);
+    for (name, stem) in &stems {
+        let scene_rows: Vec<&Row> = rows.iter().filter(|r| r.scene == *name).collect();
+        written.extend(plot_scene(&args.out, name, stem, &scene_rows)?);
     }
     // The table last: an unwritable standard output loses no file.
     crate::print_out(&table(&rows))?;
@@ -317,11 +345,21 @@ fn table(rows: &[Row]) -> String {
     out
 }
 
-/// A file-name-safe form of a scene name ("pyramid 20" → "pyramid_20").
+/// A file-name-safe form of a scene name ("pyramid 20" → "pyramid_20"; "unnamed" for an empty
+/// name, whose plots were written beside the output directory as `OUT.svg` and `OUT.png`).
 fn slug(name: &str) -> String {
+    if name.is_empty() {
+        return "unnamed".to_string();
+    }
     name.chars()
         .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
         .collect()
+}
+
+/// The two files of a scene's plot: `<out>/<stem>.svg` and `.png`.
+fn plot_paths(out: &Path, stem: &str) -> [PathBuf; 2] {
+    let base = out.join(stem);
+    [base.with_extension("svg"), base.with_extension("png")]
 }
 
 /// Which error a scene's plot shows on its y axis.
@@ -374,9 +412,7 @@ const FLOOR: f64 = 1e-7;
 fn plot_scene(out: &Path, name: &str, stem: &str, rows: &[&Row]) -> Result<Vec<PathBuf>, String> {
     register_font();
     let plotted = Plotted::of(rows);
-    let base = out.join(stem);
-    let svg = base.with_extension("svg");
-    let png = base.with_extension("png");
+    let [svg, png] = plot_paths(out, stem);
     let (svg_staged, png_staged) = (Staged::new(&svg), Staged::new(&png));
     const SIZE: (u32, u32) = (800, 560);
     draw(

@@ -266,7 +266,7 @@ fn check_outputs(scene: &Path, outputs: &[(&str, Option<&Path>)]) -> Result<(), 
 
 /// The path a file is known by: canonical when it exists, else its directory's canonical path
 /// joined with its name (so `./a.csv` and `a.csv` are one file).
-fn identity(path: &Path) -> PathBuf {
+pub(crate) fn identity(path: &Path) -> PathBuf {
     if let Ok(p) = std::fs::canonicalize(path) {
         return p;
     }
@@ -282,8 +282,9 @@ fn identity(path: &Path) -> PathBuf {
 
 /// Whether `path` can be written, without truncating it if it exists. An existing target
 /// that is not a regular file (a device, a named pipe) is not opened: a pipe without a reader
-/// would block here; it is written at the end ([`Staged`]).
-fn writable(path: &Path) -> std::io::Result<()> {
+/// would block here; it is written at the end ([`Staged`]). Such a target must exist (a
+/// misspelt `/dev/stdot` failed only after the whole run).
+pub(crate) fn writable(path: &Path) -> std::io::Result<()> {
     if path.is_dir() {
         return Err(std::io::Error::other("it is a directory"));
     }
@@ -291,7 +292,7 @@ fn writable(path: &Path) -> std::io::Result<()> {
     // "File exists"), or nothing to check for a target written into.
     let (path, stream) = crate::staged::resolve(path);
     if stream {
-        return Ok(());
+        return std::fs::metadata(&path).map(|_| ());
     }
     let path = path.as_path();
     if path.exists() {

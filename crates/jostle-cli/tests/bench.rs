@@ -211,3 +211,62 @@ fn scenes_of_the_same_name_from_two_files_are_kept_apart() {
         .count();
     assert_eq!(pngs, 2, "one plot per file");
 }
+
+/// A scene that is one of the bench's own outputs is refused before any run, and loses
+/// nothing: a scene saved as `OUT/results.csv`, or as the plot its name gives (`OUT/drop.svg`),
+/// was replaced by the results and the bench exited 0.
+#[test]
+fn a_scene_among_the_outputs_is_refused_and_kept() {
+    let dir = temp_dir().join("own-input");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = "Scene(name: \"drop\", steps: 10, bodies: [\
+                  Body(name: \"ground\", shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true),\
+                  Body(name: \"ball\", shape: Ball(radius: 0.5), position: (0.0, 1.0, 0.0))])";
+    for name in ["results.csv", "drop.svg", "drop.png"] {
+        let scene = dir.join(name);
+        std::fs::write(&scene, text).unwrap();
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_jostle"))
+            .args(["bench", "--resolver", "soft-step", "--out"])
+            .arg(&dir)
+            .arg(&scene)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{name}: accepted");
+        assert!(stderr.contains("is the scene"), "{name}: {stderr}");
+        assert_eq!(std::fs::read_to_string(&scene).unwrap(), text, "{name}");
+        std::fs::remove_file(&scene).unwrap();
+    }
+}
+
+/// A scene without a name gets `unnamed.svg` and `.png` inside the output directory: its
+/// plots were written beside it as `OUT.svg` and `OUT.png`, and with `--out .` the bench
+/// failed after every run.
+#[test]
+fn a_scene_without_a_name_plots_inside_the_output_directory() {
+    let dir = temp_dir().join("no-name");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("noname.ron");
+    std::fs::write(
+        &scene,
+        "Scene(name: \"\", steps: 10, bodies: [\
+           Body(name: \"ground\", shape: HalfSpace(normal: (0.0, 1.0, 0.0)), fixed: true),\
+           Body(name: \"ball\", shape: Ball(radius: 0.5), position: (0.0, 1.0, 0.0))])",
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    bench(&[
+        scene.as_os_str(),
+        "--resolver".as_ref(),
+        "soft-step".as_ref(),
+        "--out".as_ref(),
+        out_dir.as_os_str(),
+    ]);
+    for ext in ["svg", "png"] {
+        assert!(out_dir.join(format!("unnamed.{ext}")).is_file(), "{ext}");
+        assert!(
+            !dir.join(format!("out.{ext}")).exists(),
+            "{ext} beside --out"
+        );
+    }
+}

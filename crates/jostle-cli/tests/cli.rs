@@ -430,7 +430,8 @@ fn a_snapshot_continues_the_trace_bit_for_bit() {
 /// An output that is the scene itself, or another output, is refused before anything is
 /// written, and a bad output loses nothing already on disk (issue 16): `--trace scene.ron`
 /// used to overwrite the scene with CSV and exit 0, and `--render keep.png --trace
-/// /nonexistent/t.csv` truncated keep.png to 0 bytes.
+/// /nonexistent/t.csv` truncated keep.png to 0 bytes; `--trace /dev/stdot` failed after the
+/// run.
 #[test]
 fn outputs_never_overwrite_the_scene_each_other_or_an_untouched_file() {
     let scene = temp("own.ron");
@@ -474,6 +475,21 @@ fn outputs_never_overwrite_the_scene_each_other_or_an_untouched_file() {
         (
             vec!["run", s, "--steps", "3", "--render", k, "--fps", "0"],
             "--fps",
+        ),
+        // A device path that does not exist (a misspelt `/dev/stdout`) was tried only after
+        // the whole run.
+        (
+            vec![
+                "run",
+                s,
+                "--steps",
+                "3",
+                "--render",
+                k,
+                "--trace",
+                "/dev/jostle-no-such-device.csv",
+            ],
+            "--trace",
         ),
     ];
     for (args, expect) in cases {
