@@ -1,4 +1,4 @@
-//! Determinism is a tested contract (STYLE.md §9): the same scene and settings give
+//! Determinism is a tested contract: the same scene and settings give
 //! bit-identical results across runs, a golden hash pins the final state of a 500-step scene,
 //! and a snapshot continues a run bit for bit.
 //!

@@ -193,7 +193,7 @@ pub fn sweep(
     // the motion a body may make without CCD instead (a quarter of its thickness), a spinning
     // box was stopped where its translation alone would touch, short of where the turning
     // body gets, stopped again every step, and hung in the air while gravity filled its
-    // velocity (benches/RESULTS.md, "CCD stops where the body gets").
+    // velocity (benches/RESULTS.md, "Restitution 1 never raises a bounce").
     let turning = angle * shape.extent > 0.5 * settings.slop;
     let swept = if turning {
         let reach = Vec3::splat(shape.extent);

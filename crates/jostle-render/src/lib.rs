@@ -4,8 +4,8 @@
 //!
 //! In: the facade's read-only views of a world (bodies' display meshes and poses, half-space
 //! planes, contacts) and [`RenderSettings`]. Out: `image::RgbImage`s, saved as PNG with
-//! `image`, or appended to a [`GifWriter`]. It depends on the facade `jostle` and on `image`
-//! only: never on parry or the engine's layers.
+//! `image`, or appended to a [`GifWriter`]. It depends on the facade `jostle`, `image` and
+//! `thiserror` only: never on parry or the engine's layers.
 //!
 //! What a frame shows: a sky gradient; every half-space as an unbounded plane with a 1 m grid,
 //! fading into the horizon; every other body's mesh with flat Lambert shading from a fixed sun

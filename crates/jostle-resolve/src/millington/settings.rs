@@ -1,4 +1,4 @@
-//! The Millington resolver's tunables, in one place (STYLE.md §7): tolerances, iteration
+//! The Millington resolver's tunables, in one place: tolerances, iteration
 //! budgets, the projection method and the pick strategy.
 //!
 //! Every default is the value of the seed lecture / Cyclone unless its rustdoc says otherwise.

@@ -263,8 +263,8 @@ const RECENT_RUNS: usize = 4;
 /// steps and judged on the third.
 /// Measured why: on
 /// one two-core virtual machine the team took the 3D pyramid of 10 layers (315 batches) from
-/// 2.39 to 1.95 ms per step, on another from 2.29 to 2.7 (benches/RESULTS.md, "Threads
-/// chosen by the clock").
+/// 2.39 to 1.95 ms per step, on another from 2.29 to 2.7 (benches/RESULTS.md, "Interleaved
+/// relax, threads chosen by the clock, and six substeps measured").
 #[derive(Clone, Copy, Debug, Default)]
 struct ThreadChoice {
     /// The last [`RECENT_RUNS`] counted costs per point (ns) of each mode, one thread and the

@@ -1,4 +1,4 @@
-//! The soft-step resolver's tunables, in one place (STYLE.md §7).
+//! The soft-step resolver's tunables, in one place.
 //!
 //! The defaults start from Box2D v3's (`b2DefaultWorldDef`: damping ratio 10, push-out 3 m/s,
 //! restitution threshold 1 m/s; speculative distance 4 × linear slop = 0.02 m) with its 4
