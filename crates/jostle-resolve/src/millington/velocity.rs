@@ -131,8 +131,22 @@ pub fn friction_pick(p: &PreparedContact, bodies: &[SolverBody]) -> FrictionPick
         return no_friction(Vec3::ZERO);
     }
     let (k, dead) = without_dead_tangents(impulse_matrix(p, bodies));
-    let det = k.determinant();
-    let scale = k.x_axis.x * k.y_axis.y * k.z_axis.z;
+    // K's entries are inverse masses: for bodies of 10¹⁴ kg and more its determinant, a cube
+    // of them, fell below f32's normal range and its inverse overflowed, so friction was lost
+    // and a spinning box of 10¹⁶ kg gained a fifth of its energy. Where the normal response is
+    // below [`SMALL_RESPONSE`], K is solved scaled to a unit normal response (K₀₀ > 0:
+    // `normal_inertia` above); elsewhere exactly as before.
+    let unit = if k.x_axis.x < SMALL_RESPONSE {
+        1.0 / k.x_axis.x
+    } else {
+        1.0
+    };
+    if !(unit.is_finite() && unit > 0.0) {
+        return no_friction(frictionless_impulse(p));
+    }
+    let k_unit = k * unit;
+    let det = k_unit.determinant();
+    let scale = k_unit.x_axis.x * k_unit.y_axis.y * k_unit.z_axis.z;
     if !(det.abs() > 1e-6 * scale) {
         return no_friction(frictionless_impulse(p));
     }
@@ -149,7 +163,7 @@ pub fn friction_pick(p: &PreparedContact, bodies: &[SolverBody]) -> FrictionPick
     };
     let live = Vec3::new(1.0, f32::from(!dead[0]), f32::from(!dead[1]));
     let target = Vec3::new(desired, -p.velocity.y, -p.velocity.z) * live;
-    let g = (k.inverse() * target) * live;
+    let g = (k_unit.inverse() * (target * unit)) * live;
     coulomb_accumulated(
         p.impulse,
         g,
@@ -195,6 +209,14 @@ const DEAD_DIRECTION: f32 = 1e-9;
 pub fn coulomb(g: Vec3, k: Mat3, desired: f32, mu: f32) -> Vec3 {
     coulomb_accumulated(Vec3::ZERO, g, k, desired, mu, Vec3::ZERO, 0.0).applied
 }
+
+/// Normal response K₀₀ (s/kg) below which a pick's contact matrix is solved scaled (bodies of
+/// about 10¹² kg and more).
+const SMALL_RESPONSE: f32 = 1e-12;
+
+/// Impulse (N·s) beyond which products of impulses are formed scaled: squares of impulses
+/// leave f32's range from about 1.8·10¹⁹ N·s.
+const LARGE_IMPULSE: f32 = 1e18;
 
 /// Below this sliding speed (m/s) the sliding direction is taken as undefined and dynamic
 /// friction falls back to the planar direction of the stop-dead impulse.
@@ -246,7 +268,12 @@ pub fn coulomb_accumulated(
             saturated: true,
         };
     }
-    let planar = (total.y * total.y + total.z * total.z).sqrt();
+    // (Through `hypot` for impulses whose squares leave f32's range: bodies of 10²¹ kg.)
+    let planar = if total.y.abs().max(total.z.abs()) > LARGE_IMPULSE {
+        total.y.hypot(total.z)
+    } else {
+        (total.y * total.y + total.z * total.z).sqrt()
+    };
     let cone = mu * total.x;
     if planar <= cone {
         // Static (total.x ≥ 0 here): the solved impulse is applied as it is. Saturated when
@@ -638,6 +665,14 @@ pub fn share_manifold_friction(
         }
     }
     let (k11, k12, k22) = (t1.dot(k * t1), t1.dot(k * t2), t2.dot(k * t2));
+    // K's entries are inverse masses: scaled to unit trace where their products would leave
+    // f32's normal range (bodies of about 10¹⁵ kg and more), the solution scaled back.
+    let unit = if k11 + k22 < 1e-15 && k11 + k22 > 0.0 {
+        1.0 / (k11 + k22)
+    } else {
+        1.0
+    };
+    let (k11, k12, k22) = (k11 * unit, k12 * unit, k22 * unit);
     let det = k11 * k22 - k12 * k12;
     let (v1, v2) = (t1.dot(v), t2.dot(v));
     if v1.hypot(v2) < velocity_epsilon {
@@ -645,20 +680,26 @@ pub fn share_manifold_friction(
         return None;
     }
     let stop = if det > 1e-6 * (k11 * k22).max(f32::MIN_POSITIVE) {
-        let p1 = -(k22 * v1 - k12 * v2) / det;
-        let p2 = -(k11 * v2 - k12 * v1) / det;
+        let p1 = -(k22 * v1 - k12 * v2) / det * unit;
+        let p2 = -(k11 * v2 - k12 * v1) / det * unit;
         t1 * p1 + t2 * p2
     } else {
         Vec3::ZERO
     };
     // Each point's shared friction is aᵢ + α·bᵢ; the largest α ≤ 1 that keeps every point
     // inside its cone (α = 0 must: else nothing is done).
+    // (In units of the total load where the fourth powers below would leave f32's range.)
+    let per_load = if total_n > LARGE_IMPULSE.sqrt() {
+        1.0 / total_n
+    } else {
+        1.0
+    };
     let mut alpha = 1.0f32;
     for p in contacts.iter() {
         let load = p.impulse.x.max(0.0);
-        let limit = (1.0 - SHARED_FRICTION_MARGIN) * p.friction * load;
-        let a = tangential * (load / total_n) + n.cross(offset(p)) * (s * load);
-        let b = stop * (load / total_n);
+        let limit = (1.0 - SHARED_FRICTION_MARGIN) * p.friction * load * per_load;
+        let a = (tangential * (load / total_n) + n.cross(offset(p)) * (s * load)) * per_load;
+        let b = stop * (load / total_n) * per_load;
         let (aa, ab, bb) = (a.length_squared(), a.dot(b), b.length_squared());
         if !(aa < limit * limit) {
             return None;

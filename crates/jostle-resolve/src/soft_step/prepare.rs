@@ -19,6 +19,10 @@ use super::softness::Softness;
 use crate::{Contact, SolverBody};
 use jostle_math::{Mat3, Vec3};
 
+/// Trace (s/kg) of a contact's tangent response K below which [`prepare_point`] inverts K
+/// scaled to unit trace: bodies of about 10¹⁵ kg and more.
+const SMALL_TANGENT_TRACE: f32 = 1e-15;
+
 /// What [`prepare_point`] needs besides the contact and its bodies.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PrepareParams {
@@ -182,9 +186,17 @@ pub fn prepare_point<F: Lane>(
     let k11 = linear(t1, t1, true) + rt_a[0].dot(ang_a_tangent[0]) + rt_b[0].dot(ang_b_tangent[0]);
     let k12 = linear(t1, t2, false) + rt_a[0].dot(ang_a_tangent[1]) + rt_b[0].dot(ang_b_tangent[1]);
     let k22 = linear(t2, t2, true) + rt_a[1].dot(ang_a_tangent[1]) + rt_b[1].dot(ang_b_tangent[1]);
+    // K's entries are inverse masses: for bodies of about 10²⁰ kg its determinant fell below
+    // f32's normal range and its inverse overflowed (a box of 8·10¹⁹ kg at rest on the ground
+    // went NaN at its first step). Where K is that small it is inverted scaled to unit trace
+    // (K⁻¹ = adj(uK)·u / det(uK), u = 1/tr K); elsewhere exactly as before.
+    let trace = k11 + k22;
+    let small = trace.cmpgt(F::ZERO) & trace.cmplt(F::splat(SMALL_TANGENT_TRACE));
+    let u = F::select(small, trace.recip(), F::ONE);
+    let (k11, k12, k22) = (k11 * u, k12 * u, k22 * u);
     let det = k11 * k22 - k12 * k12;
     let invertible = det.cmpgt(F::splat(f32::EPSILON) * k11 * k22) & det.is_finite_mask();
-    let inv_det = F::select(invertible, det.recip(), F::ZERO);
+    let inv_det = F::select(invertible, det.recip() * u, F::ZERO);
     // A singular K (rank 1: the bodies cannot move along one tangent direction, as bodies
     // kept in a plane by their locks cannot leave it) takes its pseudo-inverse K/tr(K)²:
     // friction along the direction that moves, none along the other. (Zero for padding.)
@@ -193,8 +205,12 @@ pub fn prepare_point<F: Lane>(
         linear(n, t1, false) + rt_a[0].dot(ang_a_normal) + rt_b[0].dot(ang_b_normal),
         linear(n, t2, false) + rt_a[1].dot(ang_a_normal) + rt_b[1].dot(ang_b_normal),
     ];
-    let trace = k11 + k22;
-    let pseudo = F::select(trace.cmpgt(F::ZERO), (trace * trace).recip(), F::ZERO);
+    // The pseudo-inverse K/tr(K)²: of the scaled K, uK·u.
+    let pseudo = F::select(
+        small,
+        u,
+        F::select(trace.cmpgt(F::ZERO), (trace * trace).recip(), F::ZERO),
+    );
     let tangent_mass = [
         F::select(invertible, k22 * inv_det, k11 * pseudo),
         F::select(invertible, -k12 * inv_det, k12 * pseudo),

@@ -528,8 +528,13 @@ fn friction_change<F: Lane>(p: &mut PointLanes<F>, vt1: F, vt2: F, chord_time: F
     let mut new1 = old1 - (k0 * vt1 + k1 * vt2);
     let mut new2 = old2 - (k1 * vt1 + k2 * vt2);
     let limit = p.friction * p.normal_impulse;
-    let len_sq = new1 * new1 + new2 * new2;
-    let over = len_sq.cmpgt(limit * limit);
+    // Compared in units of the limit where squares of impulses would leave f32's range
+    // (bodies of about 10²⁰ kg and more); elsewhere exactly as before.
+    let large = limit.cmpgt(F::splat(LARGE_TANGENT_MASS));
+    let per_limit = F::select(large, limit.recip(), F::ONE);
+    let (s1, s2, scaled_limit) = (new1 * per_limit, new2 * per_limit, limit * per_limit);
+    let len_sq = s1 * s1 + s2 * s2;
+    let over = len_sq.cmpgt(scaled_limit * scaled_limit);
     if over.any() {
         // Most lanes over the limit have none (no normal impulse: a speculative contact, an
         // unloaded corner) and simply get no friction; the projection is for the others.
@@ -544,13 +549,29 @@ fn friction_change<F: Lane>(p: &mut PointLanes<F>, vt1: F, vt2: F, chord_time: F
     [new1 - old1, new2 - old2]
 }
 
+/// Trace of K⁻¹ (kg), or friction limit (N·s), above which the friction row's cone test and
+/// [`project_to_disk`] work in scaled units, so that no square leaves f32's range.
+const LARGE_TANGENT_MASS: f32 = 1e12;
+
 /// The point of the disk of radius `r` closest to `target` in the metric of K, where
 /// `inv_k` = K⁻¹ (symmetric: \[0,0\], \[0,1\], \[1,1\]), for the lanes in `over` (|target| > r ≥ 0);
 /// other lanes keep `target`. Lanes whose K⁻¹ is singular fall back to scaling `target` onto
 /// the disk. The result is scaled onto the circle exactly, so |λ| ≤ r holds to rounding.
 #[inline(always)]
 fn project_to_disk<F: Lane>(inv_k: [F; 3], target: [F; 2], r: F, over: F::Mask) -> [F; 2] {
+    // The closest point does not change when K is scaled, and scales with the disk: solved for
+    // K⁻¹ of unit trace and the unit disk where K⁻¹ (masses) or the disk exceed
+    // [`LARGE_TANGENT_MASS`], so that no product leaves f32's range (for a box of 8·10¹⁹ kg on
+    // the ground det K⁻¹ overflowed); elsewhere exactly as before.
     let [a, b, c] = inv_k;
+    let trace = a + c;
+    let large = trace.cmpgt(F::splat(LARGE_TANGENT_MASS)) | r.cmpgt(F::splat(LARGE_TANGENT_MASS));
+    let unit = F::select(large & trace.cmpgt(F::ZERO), trace.recip(), F::ONE);
+    let (a, b, c) = (a * unit, b * unit, c * unit);
+    let (full_target, full_r) = (target, r);
+    let to_unit = F::select(large & r.cmpgt(F::ZERO), r.recip(), F::ONE);
+    let target = [target[0] * to_unit, target[1] * to_unit];
+    let r = r * to_unit;
     let det_inv = a * c - b * b;
     let invertible = det_inv.cmpgt(F::ZERO);
     let scale = F::select(invertible, det_inv.recip(), F::ZERO);
@@ -588,16 +609,28 @@ fn project_to_disk<F: Lane>(inv_k: [F; 3], target: [F; 2], r: F, over: F::Mask) 
     let u = [m22 * rhs1 - k12 * rhs2, m11 * rhs2 - k12 * rhs1];
     // Exactly onto the circle; the Newton result is already there to rounding.
     let len = (u[0] * u[0] + u[1] * u[1]).sqrt();
-    let projected = [u[0] * (r / len), u[1] * (r / len)];
-    let scaled = [target[0] * (r / target_len), target[1] * (r / target_len)];
+    let projected = [u[0] * (full_r / len), u[1] * (full_r / len)];
+    let full_len = (full_target[0] * full_target[0] + full_target[1] * full_target[1]).sqrt();
+    let scaled = [
+        full_target[0] * (full_r / full_len),
+        full_target[1] * (full_r / full_len),
+    ];
     let usable = invertible
         & len.cmpgt(F::ZERO)
         & projected[0].is_finite_mask()
         & projected[1].is_finite_mask();
     // Not a closure: it would not be compiled with the kernel's target features.
     [
-        F::select(over, F::select(usable, projected[0], scaled[0]), target[0]),
-        F::select(over, F::select(usable, projected[1], scaled[1]), target[1]),
+        F::select(
+            over,
+            F::select(usable, projected[0], scaled[0]),
+            full_target[0],
+        ),
+        F::select(
+            over,
+            F::select(usable, projected[1], scaled[1]),
+            full_target[1],
+        ),
     ]
 }
 
