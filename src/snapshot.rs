@@ -347,6 +347,23 @@ mod file {
                 .check()
                 .map_err(|e| invalid(format!("colliders: {e}")))?;
             world.bodies = snapshot.bodies;
+            // Names tell bodies apart in errors, traces and `analytic` as in a scene file,
+            // which refuses a repeated one (a snapshot's was accepted, and its trace had two
+            // indistinguishable rows a step). Unnamed bodies are known by their place.
+            let mut seen = std::collections::HashMap::new();
+            for (handle, body) in world.bodies.iter() {
+                if body.name.is_empty() {
+                    continue;
+                }
+                if let Some(first) = seen.insert(body.name.as_str(), handle.index()) {
+                    return Err(invalid(format!(
+                        "body {} \"{}\": field `name`: the same name as body {first}; names must \
+                         be unique",
+                        handle.index(),
+                        body.name
+                    )));
+                }
+            }
             let gravity = world.settings.gravity.length();
             let slots: Vec<_> = world.bodies.iter().map(|(h, _)| h).collect();
             for handle in slots {

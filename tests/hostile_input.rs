@@ -244,6 +244,34 @@ fn a_snapshot_names_the_body_or_collider_and_the_field_it_refuses() {
     }
 }
 
+/// A snapshot whose bodies share a name is refused naming the body and the field, as a scene
+/// file is: it was accepted, and its trace had two indistinguishable rows a step.
+#[test]
+fn a_snapshot_with_two_bodies_of_one_name_is_refused() {
+    let text = snapshot_text();
+    let names: Vec<&str> = text
+        .match_indices("name: \"")
+        .map(|(at, m)| {
+            let rest = &text[at + m.len()..];
+            &rest[..rest.find('"').expect("closed")]
+        })
+        .filter(|n| !n.is_empty())
+        .collect();
+    let (first, second) = (names[1], names[2]);
+    assert_ne!(first, second);
+    let edited = text.replacen(
+        &format!("name: \"{second}\""),
+        &format!("name: \"{first}\""),
+        1,
+    );
+    let snapshot = Snapshot::parse(&edited, "edited.ron").expect("still parses");
+    let e = match World::from_snapshot(snapshot) {
+        Ok(_) => panic!("accepted two bodies of one name"),
+        Err(e) => e.to_string(),
+    };
+    assert!(e.contains("`name`") && e.contains(first), "{e}");
+}
+
 #[test]
 fn api_values_beyond_the_limits_are_refused() {
     use jostle::{BodyDesc, ShapeDesc, StepError, Vec3, WorldSettings};

@@ -238,8 +238,8 @@ pub fn run(args: RunArgs) -> Result<(), String> {
 /// may be the scene being read or another output (an output named like the input used to
 /// overwrite the scene with CSV and exit 0), and each must be writable (a trace into a missing
 /// directory used to fail after the PNG had been truncated, and a snapshot was tried only after
-/// the whole run). The check opens an existing file without truncating it and removes a file
-/// it had to create.
+/// the whole run), and none may be named for another output's format (`--trace out.png`). The
+/// check opens an existing file without truncating it and removes a file it had to create.
 fn check_outputs(scene: &Path, outputs: &[(&str, Option<&Path>)]) -> Result<(), String> {
     let scene_id = identity(scene);
     let mut seen: Vec<(&str, PathBuf)> = Vec::new();
@@ -255,6 +255,28 @@ fn check_outputs(scene: &Path, outputs: &[(&str, Option<&Path>)]) -> Result<(), 
         if let Some((other, _)) = seen.iter().find(|(_, p)| *p == id) {
             return Err(format!(
                 "{flag} {}: {other} writes the same file; choose another",
+                path.display()
+            ));
+        }
+        // An extension that names another of the outputs' formats is a mix-up (`--trace
+        // out.png --snapshot snap.csv` wrote CSV into the PNG and RON into the CSV); any other,
+        // or none (`/dev/stdout`), is taken as asked.
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        let foreign: &[&str] = match flag {
+            "--trace" => &["png", "gif", "ron", "svg", "jpg", "jpeg"],
+            "--snapshot" => &["csv", "png", "gif", "svg", "jpg", "jpeg"],
+            _ => &[],
+        };
+        if let Some(ext) = ext.filter(|e| foreign.contains(&e.as_str())) {
+            let writes = if flag == "--trace" {
+                "CSV"
+            } else {
+                "a RON snapshot"
+            };
+            return Err(format!(
+                "{flag} {}: {flag} writes {writes}, not a .{ext} file; choose another name",
                 path.display()
             ));
         }

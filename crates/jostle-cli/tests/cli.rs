@@ -476,6 +476,11 @@ fn outputs_never_overwrite_the_scene_each_other_or_an_untouched_file() {
             vec!["run", s, "--steps", "3", "--render", k, "--fps", "0"],
             "--fps",
         ),
+        // An output named for another output's format.
+        (
+            vec!["run", s, "--steps", "3", "--trace", k],
+            "not a .png file",
+        ),
         // A device path that does not exist (a misspelt `/dev/stdout`) was tried only after
         // the whole run.
         (
