@@ -78,9 +78,22 @@ pub fn mass_properties(desc: &ShapeDesc, density: f32) -> Result<MassProps, Shap
         ));
     }
     let shape = desc.build()?;
-    let props = from_parry(&shape.mass_properties(density));
-    let finite =
-        props.local_com.is_finite() && props.inertia.to_cols_array().iter().all(|x| x.is_finite());
+    let finite = |props: &MassProps| {
+        props.local_com.is_finite() && props.inertia.to_cols_array().iter().all(|x| x.is_finite())
+    };
+    let mut props = from_parry(&shape.mass_properties(density));
+    if !finite(&props) {
+        // parry combines a compound's parts through its inertia's eigenvectors, whose
+        // products of inertias leave f32's range for heavy compounds (a 100 m box with a ball
+        // on it at 10¹² kg/m³, 1.07·10¹⁸ kg, came out with a NaN inertia, while the same parts
+        // given as colliders loaded). Mass and inertia are proportional to the density: worked
+        // out at 1 kg/m³ and scaled.
+        let unit = from_parry(&shape.mass_properties(1.0));
+        if unit.mass > 0.0 && finite(&unit) {
+            props = unit.scaled_to_mass(unit.mass * density);
+        }
+    }
+    let finite = finite(&props);
     if !(props.mass.is_finite() && props.mass > 0.0 && finite) {
         // Name the field that made it degenerate: a flat hull's points, otherwise the size.
         let field = match desc {
@@ -203,6 +216,32 @@ mod tests {
         };
         let m = mass_properties(&desc, 1.0).unwrap();
         assert!((m.local_com.x - 1.0 / 3.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn a_heavy_compound_has_the_mass_and_inertia_of_its_parts() {
+        let parts = vec![
+            CompoundPart {
+                shape: ShapeDesc::Cuboid {
+                    half_extents: Vec3::splat(50.0),
+                },
+                position: Vec3::ZERO,
+                rotation: jostle_math::Quat::IDENTITY,
+            },
+            CompoundPart {
+                shape: ShapeDesc::Ball { radius: 25.0 },
+                position: Vec3::new(0.0, 50.0, 0.0),
+                rotation: jostle_math::Quat::IDENTITY,
+            },
+        ];
+        let desc = ShapeDesc::Compound { parts };
+        let light = mass_properties(&desc, 1.0).unwrap();
+        let heavy = mass_properties(&desc, 1e12).unwrap();
+        assert!(
+            (heavy.mass / light.mass / 1e12 - 1.0).abs() < 1e-5,
+            "{heavy:?}"
+        );
+        assert_close(diag(heavy.inertia) / 1e12, diag(light.inertia), 1e-5);
     }
 
     #[test]
