@@ -165,6 +165,8 @@ mod file {
 
         /// Parses snapshot text; `file` names its origin in errors.
         pub fn parse(text: &str, file: &str) -> Result<Snapshot, SnapshotError> {
+            // A byte-order mark is not RON (as in `Scene::parse`).
+            let text = text.strip_prefix('\u{feff}').unwrap_or(text);
             let snapshot: Snapshot = ron::from_str(text).map_err(|e| SnapshotError::Parse {
                 file: file.into(),
                 line: e.span.start.line,

@@ -104,7 +104,13 @@ impl SceneError {
 
     pub(crate) fn from_ron(file: &str, text: &str, e: ron::error::SpannedError) -> Self {
         let pos = e.span.start;
-        let mut message = e.code.to_string();
+        // ron's own advice for deep nesting names its API, which a scene's author cannot use.
+        let mut message = match e.code {
+            ron::Error::ExceededRecursionLimit => {
+                "nested too deeply (compounds or brackets more than 128 levels deep)".to_string()
+            }
+            ref code => code.to_string(),
+        };
         if let Some(hint) = hint(text, pos.line, pos.col, &message) {
             message = format!("{message} ({hint})");
         }

@@ -391,6 +391,9 @@ impl Scene {
 
     /// Parses scene text; `file` names its origin in errors. Validates the whole scene.
     pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
+        // A byte-order mark (editors on Windows write one) is not RON: it was refused as
+        // "Expected opening `(`" at 1:1.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         // IMPLICIT_SOME: `mass: 8.0` for an optional field; UNWRAP_VARIANT_NEWTYPES:
         // `resolver: Millington(velocity_iterations: 64)` without doubled parentheses.
         let options = ron::Options::default().with_default_extension(
