@@ -22,6 +22,7 @@
 //! emptied: whatever parry found there is its error. Near a large triangle's vertex (two
 //! edges in the shadow) parry's answer is kept.
 
+use crate::polytope::take_contact;
 use jostle_math::Vec3;
 use parry3d::math::Pose;
 use parry3d::query::details::NormalConstraints;
@@ -114,9 +115,7 @@ pub(crate) fn refine<D: Default + Copy + Send + Sync + 'static>(
             continue;
         }
         // The manifold keeps its triangle and its data; the points are the patch's.
-        m.points = fresh.points;
-        m.local_n1 = fresh.local_n1;
-        m.local_n2 = fresh.local_n2;
+        take_contact(m, fresh);
         if let Some(features) = flat {
             on_face(m, &patch, features, pos12, mesh_first, prediction);
         }
@@ -164,12 +163,9 @@ fn on_face<D: Default + Copy>(
         let in_other = pos12.rotation * -face;
         crate::polytope::clip_along(features, triangle, pos12, in_other, prediction)
     };
-    if fresh.points.is_empty() {
-        return;
+    if !fresh.points.is_empty() {
+        take_contact(m, fresh);
     }
-    m.points = fresh.points;
-    m.local_n1 = fresh.local_n1;
-    m.local_n2 = fresh.local_n2;
 }
 
 /// `shape` as a triangle mesh, if it is one.

@@ -266,14 +266,18 @@ pub(crate) fn check<D: Default + Copy>(
         match verdict(&pose, part1, part2, prediction, Some(m)) {
             Verdict::Keep => {}
             Verdict::Clear => m.points.clear(),
-            Verdict::Replace(face) => {
-                // The part pair's manifold keeps its parts and their poses.
-                m.points = face.points;
-                m.local_n1 = face.local_n1;
-                m.local_n2 = face.local_n2;
-            }
+            // The part pair's manifold keeps its parts and their poses.
+            Verdict::Replace(face) => take_contact(m, face),
         }
     }
+}
+
+/// Puts `contact`'s points and normals in `m`, which keeps its sub-shapes, their poses and its
+/// data.
+pub(crate) fn take_contact<D>(m: &mut ContactManifold<(), D>, contact: ContactManifold<(), D>) {
+    m.points = contact.points;
+    m.local_n1 = contact.local_n1;
+    m.local_n2 = contact.local_n2;
 }
 
 /// `shape` as a compound, if it is one.
