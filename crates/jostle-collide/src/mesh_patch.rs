@@ -15,12 +15,17 @@
 //! [`refine`] asks parry again with an equilateral triangle in the same plane that covers that
 //! sphere's shadow: the same contact, from vertices near the shape. Where the sphere's shadow
 //! crosses one edge of the triangle (two large triangles meeting under the shape), the patch
-//! is a triangle on that edge whose other sides stay outside the shadow. The patch's face and
-//! that edge are the triangle's, with the mesh's pseudo-normals, so the points keep their
-//! feature ids and their carried impulses. Where the sphere cannot reach the triangle at all
-//! (farther from its plane, or beyond one of its edges, than its radius) the manifold is
-//! emptied: whatever parry found there is its error. Near a large triangle's vertex (two
-//! edges in the shadow) parry's answer is kept.
+//! is a triangle on that edge whose other sides stay outside the shadow. The query takes the
+//! mesh's pseudo-normals; the patch's face has the triangle's face id, so points on it keep
+//! their carried impulses (a point on the edge takes the patch's edge id). Where the sphere
+//! cannot reach the triangle at all (farther from its plane, or beyond one of its edges, than
+//! its radius) the manifold is emptied: whatever parry found there is its error. Near a large
+//! triangle's vertex (two edges in the shadow) parry's answer is kept.
+//!
+//! Then, on every triangle, large or not, a flat-faced shape (box, cylinder, hull) whose
+//! contact normal is the face's gets its points clipped along the face normal ([`on_face`]):
+//! within a micrometre of touching parry took the shape's support feature along a direction
+//! turned by rounding, and a cylinder lying on a 20 m floor rolled away.
 
 use crate::polytope::take_contact;
 use jostle_math::Vec3;
@@ -36,10 +41,10 @@ use parry3d::shape::{Shape, ShapeType, TriMesh, Triangle};
 /// second query, so it is asked from 1,000.
 const LARGE: f32 = 1000.0;
 
-/// Recomputes each of `manifolds` (a mesh and a convex shape, `pos12` shape 2's pose in shape
-/// 1's frame) whose triangle is [`LARGE`] beside the shape and lies under it away from its
-/// edges, against a patch of the triangle around the shape (the module docs). Other manifolds
-/// and other pairs of shapes are left as they are.
+/// Recomputes each of `manifolds` (a mesh and a convex shape other than a ball, `pos12` shape
+/// 2's pose in shape 1's frame) whose triangle is [`LARGE`] beside the shape against a patch of
+/// the triangle around the shape, and clips a flat-faced shape's points on a face along its
+/// normal ([`on_face`]; the module docs). Other pairs of shapes are left as they are.
 pub(crate) fn refine<D: Default + Copy + Send + Sync + 'static>(
     pos12: &Pose,
     shape1: &dyn Shape,
