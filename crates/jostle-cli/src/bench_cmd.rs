@@ -195,11 +195,8 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
     }
     let inputs: Vec<PathBuf> = scenes.iter().map(|p| crate::run_cmd::identity(p)).collect();
     for path in &outputs {
-        if let Some(scene) = scenes
-            .iter()
-            .zip(&inputs)
-            .find(|(_, id)| **id == crate::run_cmd::identity(path))
-        {
+        let id = crate::run_cmd::identity(path);
+        if let Some(scene) = scenes.iter().zip(&inputs).find(|(_, input)| **input == id) {
             return Err(format!(
                 "--out {}: {} is the scene {} being run; choose another output directory",
                 args.out.display(),

@@ -79,50 +79,48 @@ pub(crate) fn refine<D: Default + Copy + Send + Sync + 'static>(
             continue;
         }
         let triangle = mesh.triangle(index);
-        let patch = match patch(&triangle, centre, reach) {
-            Patch::Keep => {
-                if let Some(features) = flat {
-                    on_face(m, &triangle, features, pos12, mesh_first, prediction);
-                }
-                continue;
-            }
+        // The triangle whose face the points lie on: the mesh's, or the patch standing in.
+        let face = match patch(&triangle, centre, reach) {
+            Patch::Keep => triangle,
             Patch::Apart => {
                 m.points.clear();
                 continue;
             }
-            Patch::Over(patch) => patch,
+            Patch::Over(patch) => {
+                let constraints = mesh.triangle_normal_constraints(index);
+                let constraints = constraints.as_ref().map(|c| c as &dyn NormalConstraints);
+                let mut fresh: ContactManifold<(), D> = ContactManifold::new();
+                let answer = if mesh_first {
+                    DefaultQueryDispatcher.contact_manifold_convex_convex(
+                        pos12,
+                        &patch,
+                        other,
+                        constraints,
+                        None,
+                        prediction,
+                        &mut fresh,
+                    )
+                } else {
+                    DefaultQueryDispatcher.contact_manifold_convex_convex(
+                        pos12,
+                        other,
+                        &patch,
+                        None,
+                        constraints,
+                        prediction,
+                        &mut fresh,
+                    )
+                };
+                if answer.is_err() {
+                    continue;
+                }
+                // The manifold keeps its triangle and its data; the points are the patch's.
+                take_contact(m, fresh);
+                patch
+            }
         };
-        let constraints = mesh.triangle_normal_constraints(index);
-        let constraints = constraints.as_ref().map(|c| c as &dyn NormalConstraints);
-        let mut fresh: ContactManifold<(), D> = ContactManifold::new();
-        let answer = if mesh_first {
-            DefaultQueryDispatcher.contact_manifold_convex_convex(
-                pos12,
-                &patch,
-                other,
-                constraints,
-                None,
-                prediction,
-                &mut fresh,
-            )
-        } else {
-            DefaultQueryDispatcher.contact_manifold_convex_convex(
-                pos12,
-                other,
-                &patch,
-                None,
-                constraints,
-                prediction,
-                &mut fresh,
-            )
-        };
-        if answer.is_err() {
-            continue;
-        }
-        // The manifold keeps its triangle and its data; the points are the patch's.
-        take_contact(m, fresh);
         if let Some(features) = flat {
-            on_face(m, &patch, features, pos12, mesh_first, prediction);
+            on_face(m, &face, features, pos12, mesh_first, prediction);
         }
     }
 }

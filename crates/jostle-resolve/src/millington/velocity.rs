@@ -666,8 +666,8 @@ pub fn share_manifold_friction(
     }
     let (k11, k12, k22) = (t1.dot(k * t1), t1.dot(k * t2), t2.dot(k * t2));
     // K's entries are inverse masses: scaled to unit trace where their products would leave
-    // f32's normal range (bodies of about 10¹⁵ kg and more), the solution scaled back.
-    let unit = if k11 + k22 < 1e-15 && k11 + k22 > 0.0 {
+    // f32's normal range (as in `friction_pick`), the solution scaled back.
+    let unit = if k11 + k22 < SMALL_RESPONSE && k11 + k22 > 0.0 {
         1.0 / (k11 + k22)
     } else {
         1.0

@@ -610,10 +610,9 @@ fn project_to_disk<F: Lane>(inv_k: [F; 3], target: [F; 2], r: F, over: F::Mask) 
     // Exactly onto the circle; the Newton result is already there to rounding.
     let len = (u[0] * u[0] + u[1] * u[1]).sqrt();
     let projected = [u[0] * (full_r / len), u[1] * (full_r / len)];
-    let full_len = (full_target[0] * full_target[0] + full_target[1] * full_target[1]).sqrt();
     let scaled = [
-        full_target[0] * (full_r / full_len),
-        full_target[1] * (full_r / full_len),
+        target[0] * (full_r / target_len),
+        target[1] * (full_r / target_len),
     ];
     let usable = invertible
         & len.cmpgt(F::ZERO)
